@@ -1,0 +1,446 @@
+//! Cubic and bicubic Hermite splines with the original's linear extrapolation (`05-macro.md`, "Material ψ(z)";
+//! storage in `04-sampling-fitting.md`, "Material JSON").
+//!
+//! A spline is stored as knots plus values and slopes. For evaluation the knot line is split into *pieces*:
+//! piece 0 is the left exterior (x < t₀), pieces 1..n−1 the cells [tᵢ, tᵢ₊₁], piece n the right exterior
+//! (x > tₙ₋₁). On every piece the spline is a polynomial in the local coordinate s = (x − x₀)/h: cubic on cells,
+//! linear on the exterior pieces (value and slope of the end knot). The 2D spline is the tensor product, so outside
+//! the grid it continues linearly in each direction that left the grid, with the product (cross) term in the corners.
+//!
+//! Fast evaluation uses power-basis coefficients precomputed per piece. The generic reference implementation
+//! ([`basis_weights`]) evaluates the Hermite basis functions directly from the stored knots, values and slopes.
+
+use crate::diff::Real;
+
+/// Hermite basis in the local coordinate s ∈ [0, 1] of a cell, as power-basis coefficients (rows: weights of
+/// pᵢ, pᵢ₊₁, h·mᵢ, h·mᵢ₊₁; columns: s⁰..s³).
+const HERMITE: [[f64; 4]; 4] = [
+    [1.0, 0.0, -3.0, 2.0], // h00
+    [0.0, 0.0, 3.0, -2.0], // h01
+    [0.0, 1.0, -2.0, 1.0], // h10
+    [0.0, 0.0, -1.0, 1.0], // h11
+];
+
+/// Where a coordinate falls on a knot line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Piece {
+    /// 0 = left exterior, 1..n−1 = cell i−1, n = right exterior
+    pub index: usize,
+    /// the cell whose data defines this piece (the end cell for exterior pieces)
+    pub cell: usize,
+}
+
+/// The piece with a given index on a knot line of `n` knots.
+#[inline]
+pub fn piece_from_index(n: usize, index: usize) -> Piece {
+    Piece {
+        index,
+        cell: if index == 0 {
+            0
+        } else {
+            (index - 1).min(n - 2)
+        },
+    }
+}
+
+/// Locate `x` on strictly increasing knots `t` (at least two). NaN lands in the first cell (and stays NaN).
+#[inline]
+pub fn locate(t: &[f64], x: f64) -> Piece {
+    let n = t.len();
+    if x < t[0] {
+        Piece { index: 0, cell: 0 }
+    } else if x > t[n - 1] {
+        Piece {
+            index: n,
+            cell: n - 2,
+        }
+    } else {
+        // number of knots ≤ x, minus one, is the cell; x = t_{n−1} belongs to the last cell
+        let cell = t.partition_point(|&tk| tk <= x).clamp(1, n - 1) - 1;
+        Piece {
+            index: cell + 1,
+            cell,
+        }
+    }
+}
+
+/// Power-basis description of the four Hermite weights on one piece: weight b at x is
+/// `Σ_j w[b][j] sʲ` with `s = (x − origin) / h`. The weights multiply (p_i, p_{i+1}, m_i, m_{i+1}) of `cell`.
+#[derive(Clone, Copy, Debug)]
+pub struct BasisPiece {
+    pub origin: f64,
+    pub h: f64,
+    pub w: [[f64; 4]; 4],
+}
+
+/// The basis on a piece of knot line `t`.
+pub fn basis_piece(t: &[f64], piece: Piece) -> BasisPiece {
+    let n = t.len();
+    let i = piece.cell;
+    let h = t[i + 1] - t[i];
+    if piece.index == 0 {
+        // p₀ + m₀ (x − t₀) = p₀ + (h m₀) s
+        BasisPiece {
+            origin: t[0],
+            h,
+            w: [[1.0, 0.0, 0.0, 0.0], [0.0; 4], [0.0, h, 0.0, 0.0], [0.0; 4]],
+        }
+    } else if piece.index == n {
+        BasisPiece {
+            origin: t[n - 1],
+            h,
+            w: [[0.0; 4], [1.0, 0.0, 0.0, 0.0], [0.0; 4], [0.0, h, 0.0, 0.0]],
+        }
+    } else {
+        let mut w = HERMITE;
+        for row in w.iter_mut().skip(2) {
+            for c in row.iter_mut() {
+                *c *= h;
+            }
+        }
+        BasisPiece { origin: t[i], h, w }
+    }
+}
+
+/// Generic reference: the four Hermite weights at `x` (multiplying p_i, p_{i+1}, m_i, m_{i+1} of the returned
+/// cell), with the linear extrapolation beyond the end knots.
+pub fn basis_weights<D: Real>(t: &[f64], x: &D) -> (usize, [D; 4]) {
+    let piece = locate(t, x.re());
+    let b = basis_piece(t, piece);
+    let s = (x.clone() - b.origin) / b.h;
+    let w = std::array::from_fn(|k| {
+        let c = &b.w[k];
+        ((s.clone() * c[3] + c[2]) * s.clone() + c[1]) * s.clone() + c[0]
+    });
+    (piece.cell, w)
+}
+
+/// A 1D cubic Hermite spline (knots t, values p, slopes m) with linear extrapolation.
+#[derive(Clone, Debug)]
+pub struct Hermite1D {
+    pub t: Vec<f64>,
+    pub p: Vec<f64>,
+    pub m: Vec<f64>,
+    /// per piece: origin, 1/h and power-basis coefficients c₀..c₃ in s
+    pieces: Vec<(f64, f64, [f64; 4])>,
+}
+
+impl Hermite1D {
+    /// Build from knots, values and slopes. The caller validates lengths (≥ 2, equal) and strictly increasing,
+    /// finite knots; [`crate::material::json`] does so with file-and-field errors.
+    pub fn new(t: Vec<f64>, p: Vec<f64>, m: Vec<f64>) -> Hermite1D {
+        let n = t.len();
+        assert!(
+            n >= 2 && p.len() == n && m.len() == n,
+            "Hermite1D: invalid sizes"
+        );
+        let pieces = (0..=n)
+            .map(|index| {
+                let cell = if index == 0 {
+                    0
+                } else {
+                    (index - 1).min(n - 2)
+                };
+                let b = basis_piece(&t, Piece { index, cell });
+                let data = [p[cell], p[cell + 1], m[cell], m[cell + 1]];
+                let mut c = [0.0; 4];
+                for (k, d) in data.iter().enumerate() {
+                    for j in 0..4 {
+                        c[j] += b.w[k][j] * d;
+                    }
+                }
+                (b.origin, 1.0 / b.h, c)
+            })
+            .collect();
+        Hermite1D { t, p, m, pieces }
+    }
+
+    #[inline]
+    pub fn piece(&self, x: f64) -> usize {
+        locate(&self.t, x).index
+    }
+
+    /// Derivatives f, f′, f″, f‴ at `x` using the polynomial of piece `piece` (which need not contain x).
+    #[inline]
+    pub fn derivs_on(&self, piece: usize, x: f64) -> [f64; 4] {
+        let (x0, ih, c) = &self.pieces[piece];
+        let s = (x - x0) * ih;
+        poly_derivs(c, s, *ih)
+    }
+
+    /// f, f′, f″ at x.
+    #[inline]
+    pub fn eval2(&self, x: f64) -> [f64; 3] {
+        let d = self.derivs_on(self.piece(x), x);
+        [d[0], d[1], d[2]]
+    }
+
+    /// Generic reference value.
+    pub fn reference<D: Real>(&self, x: &D) -> D {
+        let (i, w) = basis_weights(&self.t, x);
+        let data = [self.p[i], self.p[i + 1], self.m[i], self.m[i + 1]];
+        w.into_iter()
+            .zip(data)
+            .fold(D::from(0.0), |acc, (wk, dk)| acc + wk * dk)
+    }
+}
+
+/// Value and first three derivatives of `Σ cⱼ sʲ` with respect to x, where ds/dx = `ih`.
+#[inline]
+pub fn poly_derivs(c: &[f64; 4], s: f64, ih: f64) -> [f64; 4] {
+    let v = ((c[3] * s + c[2]) * s + c[1]) * s + c[0];
+    let d1 = ((3.0 * c[3]) * s + 2.0 * c[2]) * s + c[1];
+    let d2 = 6.0 * c[3] * s + 2.0 * c[2];
+    let d3 = 6.0 * c[3];
+    [v, d1 * ih, d2 * ih * ih, d3 * ih * ih * ih]
+}
+
+/// A 2D bicubic Hermite spline on the tensor grid (tu, tv); arrays are stored with the v index outer:
+/// entry (iv, iu) at `iv·|tu| + iu` (the original's layout).
+#[derive(Clone, Debug)]
+pub struct Hermite2D {
+    pub tu: Vec<f64>,
+    pub tv: Vec<f64>,
+    pub p: Vec<f64>,
+    pub mu: Vec<f64>,
+    pub mv: Vec<f64>,
+    pub muv: Vec<f64>,
+    /// per (u piece, v piece), u piece inner: origins, 1/h and coefficients c[i][j] of sⁱ tʲ
+    pieces: Vec<Piece2>,
+    nu_pieces: usize,
+}
+
+#[derive(Clone, Debug)]
+struct Piece2 {
+    u0: f64,
+    ihu: f64,
+    v0: f64,
+    ihv: f64,
+    c: [[f64; 4]; 4],
+}
+
+/// Derivatives ∂ᵃ_u ∂ᵇ_v of the 2D spline at one point, a ≤ 2, b ≤ 3: `d[a][b]`.
+pub type Derivs2 = [[f64; 4]; 3];
+
+/// A 2D spline restricted to one u position: the three polynomials in t = (v − v₀)/h_v of ∂ᵃ_u f, a = 0, 1, 2,
+/// for each v piece being picked lazily. Used by the spectral (bending) terms, which evaluate many v at one u.
+pub struct AtU<'a> {
+    spline: &'a Hermite2D,
+    upiece: usize,
+    s: f64,
+}
+
+impl Hermite2D {
+    /// Build from the grid and the four arrays (validated by the caller: sizes |tu|·|tv|, knots increasing).
+    pub fn new(
+        tu: Vec<f64>,
+        tv: Vec<f64>,
+        p: Vec<f64>,
+        mu: Vec<f64>,
+        mv: Vec<f64>,
+        muv: Vec<f64>,
+    ) -> Hermite2D {
+        let (nu, nv) = (tu.len(), tv.len());
+        assert!(nu >= 2 && nv >= 2, "Hermite2D: need two knots per axis");
+        assert!(
+            p.len() == nu * nv
+                && mu.len() == nu * nv
+                && mv.len() == nu * nv
+                && muv.len() == nu * nv
+        );
+        let at = |a: &Vec<f64>, iu: usize, iv: usize| a[iv * nu + iu];
+        let mut pieces = Vec::with_capacity((nu + 1) * (nv + 1));
+        for jv in 0..=nv {
+            for ju in 0..=nu {
+                let pu = Piece {
+                    index: ju,
+                    cell: if ju == 0 { 0 } else { (ju - 1).min(nu - 2) },
+                };
+                let pv = Piece {
+                    index: jv,
+                    cell: if jv == 0 { 0 } else { (jv - 1).min(nv - 2) },
+                };
+                let bu = basis_piece(&tu, pu);
+                let bv = basis_piece(&tv, pv);
+                let (i, j) = (pu.cell, pv.cell);
+                // data[a][b]: a over (p_i, p_{i+1}, slope_i, slope_{i+1}) in u, b likewise in v
+                let mut data = [[0.0; 4]; 4];
+                for (a, (iu, du)) in [(i, false), (i + 1, false), (i, true), (i + 1, true)]
+                    .into_iter()
+                    .enumerate()
+                {
+                    for (b, (iv, dv)) in [(j, false), (j + 1, false), (j, true), (j + 1, true)]
+                        .into_iter()
+                        .enumerate()
+                    {
+                        data[a][b] = match (du, dv) {
+                            (false, false) => at(&p, iu, iv),
+                            (true, false) => at(&mu, iu, iv),
+                            (false, true) => at(&mv, iu, iv),
+                            (true, true) => at(&muv, iu, iv),
+                        };
+                    }
+                }
+                // c = Wuᵀ · data · Wv
+                let mut c = [[0.0; 4]; 4];
+                for a in 0..4 {
+                    for b in 0..4 {
+                        let d = data[a][b];
+                        if d == 0.0 {
+                            continue;
+                        }
+                        for (ii, ci) in c.iter_mut().enumerate() {
+                            let wa = bu.w[a][ii];
+                            if wa == 0.0 {
+                                continue;
+                            }
+                            for (jj, cij) in ci.iter_mut().enumerate() {
+                                *cij += wa * d * bv.w[b][jj];
+                            }
+                        }
+                    }
+                }
+                pieces.push(Piece2 {
+                    u0: bu.origin,
+                    ihu: 1.0 / bu.h,
+                    v0: bv.origin,
+                    ihv: 1.0 / bv.h,
+                    c,
+                });
+            }
+        }
+        Hermite2D {
+            tu,
+            tv,
+            p,
+            mu,
+            mv,
+            muv,
+            pieces,
+            nu_pieces: nu + 1,
+        }
+    }
+
+    /// Restrict to one u (for repeated evaluation along v).
+    #[inline]
+    pub fn at_u(&self, u: f64) -> AtU<'_> {
+        let upiece = locate(&self.tu, u).index;
+        let pc = &self.pieces[upiece];
+        AtU {
+            spline: self,
+            upiece,
+            s: (u - pc.u0) * pc.ihu,
+        }
+    }
+
+    #[inline]
+    pub fn v_piece(&self, v: f64) -> usize {
+        locate(&self.tv, v).index
+    }
+
+    /// f, f_u, f_v, f_uu, f_uv, f_vv at (u, v).
+    #[inline]
+    pub fn eval2(&self, u: f64, v: f64) -> [f64; 6] {
+        let d = self.at_u(u).derivs_on(self.v_piece(v), v);
+        [d[0][0], d[1][0], d[0][1], d[2][0], d[1][1], d[0][2]]
+    }
+
+    /// Generic reference value (tensor product of the Hermite basis weights, extrapolation included).
+    pub fn reference<D: Real>(&self, u: &D, v: &D) -> D {
+        let nu = self.tu.len();
+        let (i, wu) = basis_weights(&self.tu, u);
+        let (j, wv) = basis_weights(&self.tv, v);
+        let mut acc = D::from(0.0);
+        for (a, wa) in wu.iter().enumerate() {
+            let (iu, du) = [(i, false), (i + 1, false), (i, true), (i + 1, true)][a];
+            for (b, wb) in wv.iter().enumerate() {
+                let (iv, dv) = [(j, false), (j + 1, false), (j, true), (j + 1, true)][b];
+                let arr = match (du, dv) {
+                    (false, false) => &self.p,
+                    (true, false) => &self.mu,
+                    (false, true) => &self.mv,
+                    (true, true) => &self.muv,
+                };
+                acc += wa.clone() * wb.clone() * arr[iv * nu + iu];
+            }
+        }
+        acc
+    }
+}
+
+impl AtU<'_> {
+    /// The v piece of `v` (see [`Hermite2D::v_piece`]).
+    #[inline]
+    pub fn v_piece_of(&self, v: f64) -> usize {
+        self.spline.v_piece(v)
+    }
+
+    /// `d[a][b]` = ∂ᵃ_u ∂ᵇ_v f(u, v) for a ≤ 2, b ≤ 3, using the polynomial of v piece `vpiece` (which need not
+    /// contain v: the spectral terms evaluate one piece's polynomial at the mean eigenvalue).
+    #[inline]
+    pub fn derivs_on(&self, vpiece: usize, v: f64) -> Derivs2 {
+        let pc = &self.spline.pieces[vpiece * self.spline.nu_pieces + self.upiece];
+        let s = self.s;
+        // q_a[j] = Σ_i c[i][j] dᵃ/dsᵃ sⁱ
+        let mut q = [[0.0; 4]; 3];
+        let (s2, s3) = (s * s, s * s * s);
+        for j in 0..4 {
+            let c = [pc.c[0][j], pc.c[1][j], pc.c[2][j], pc.c[3][j]];
+            q[0][j] = c[0] + c[1] * s + c[2] * s2 + c[3] * s3;
+            q[1][j] = (c[1] + 2.0 * c[2] * s + 3.0 * c[3] * s2) * pc.ihu;
+            q[2][j] = (2.0 * c[2] + 6.0 * c[3] * s) * pc.ihu * pc.ihu;
+        }
+        let t = (v - pc.v0) * pc.ihv;
+        [
+            poly_derivs(&q[0], t, pc.ihv),
+            poly_derivs(&q[1], t, pc.ihv),
+            poly_derivs(&q[2], t, pc.ihv),
+        ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample1d() -> Hermite1D {
+        Hermite1D::new(
+            vec![-1.0, -0.2, 0.5, 2.0],
+            vec![3.0, 0.1, 0.4, 5.0],
+            vec![-2.0, 0.3, 1.0, 4.0],
+        )
+    }
+
+    #[test]
+    fn fast_and_reference_agree_inside_and_outside() {
+        let s = sample1d();
+        for k in 0..=400 {
+            let x = -3.0 + 7.0 * k as f64 / 400.0;
+            let a = s.eval2(x)[0];
+            let b = s.reference(&x);
+            assert!(
+                (a - b).abs() <= 1e-13 * (1.0 + b.abs()),
+                "x={x}: {a} vs {b}"
+            );
+        }
+    }
+
+    #[test]
+    fn linear_extrapolation_uses_end_slopes() {
+        let s = sample1d();
+        assert!((s.eval2(-2.0)[0] - (3.0 + 2.0)).abs() < 1e-14);
+        assert_eq!(s.eval2(-2.0)[2], 0.0);
+        assert!((s.eval2(3.0)[0] - (5.0 + 4.0)).abs() < 1e-14);
+    }
+
+    #[test]
+    fn locate_handles_ends_and_nan() {
+        let t = [0.0, 1.0, 2.0];
+        assert_eq!(locate(&t, -0.1).index, 0);
+        assert_eq!(locate(&t, 0.0).index, 1);
+        assert_eq!(locate(&t, 1.0).index, 2);
+        assert_eq!(locate(&t, 2.0).index, 2);
+        assert_eq!(locate(&t, 2.1).index, 3);
+        let _ = locate(&t, f64::NAN);
+    }
+}

@@ -1,0 +1,314 @@
+//! The spline material ψ(z) of the original method (`05-macro.md`, "Material ψ(z)"; file format in
+//! `04-sampling-fitting.md`, "Material JSON").
+//!
+//! z = (s_x, s_a, s_y, II₀₀, II₀₁, II₁₁), σ the five strain scales, L = [[II₀₀, II₀₁], [II₀₁, II₁₁]]:
+//!
+//! ψ(z) = C₀ + Σ_{k≤2} f_k(z_k/σ_k) + [f₃(L/σ₃)]₀₀ + [f₄(L/σ₄)]₁₁
+//!        + Σ_{(k,l), l≤2} f_kl(z_k/σ_k, z_l/σ_l) + Σ_(k,3) [f_k3(z_k/σ_k, L/σ₃)]₀₀ + Σ_(k,4) [f_k4(z_k/σ_k, L/σ₄)]₁₁
+//!
+//! with the matrix functions in divided-difference form ([`spectral`]). [`Material::eval`] is the fast path
+//! (value, gradient, Hessian), [`Material::reference`] its generic twin for the derivative harness.
+
+pub mod checks;
+pub mod hermite;
+pub mod json;
+pub mod spectral;
+pub mod synthetic;
+
+pub use checks::diff_checks;
+pub use hermite::{Hermite1D, Hermite2D};
+pub use json::MaterialError;
+
+use crate::diff::Real;
+use hermite::{basis_piece, basis_weights, piece_from_index};
+use spectral::{spectral_00, spectral_00_reference};
+
+/// Names of the strain components, in order.
+pub const STRAIN_NAMES: [&str; 6] = ["s_x", "s_a", "s_y", "II00", "II01", "II11"];
+
+/// A 1D term f_k of the material.
+#[derive(Clone, Debug)]
+pub struct Term1D {
+    /// 0 = s_x, 1 = s_a, 2 = s_y, 3 = x-bending, 4 = y-bending
+    pub k: usize,
+    pub spline: Hermite1D,
+}
+
+/// A 2D term f_kl of the material (k0 in-plane, k1 > k0).
+#[derive(Clone, Debug)]
+pub struct Term2D {
+    pub k0: usize,
+    pub k1: usize,
+    pub spline: Hermite2D,
+}
+
+/// A spline material: the original's format plus anything else the file carried (kept for writing).
+#[derive(Clone, Debug)]
+pub struct Material {
+    /// areal mass density ρ_A (kg/m²)
+    pub density: f64,
+    /// σ for k = 0..4
+    pub strain_scale: [f64; 5],
+    /// C₀
+    pub constant: f64,
+    pub terms1d: Vec<Term1D>,
+    pub terms2d: Vec<Term2D>,
+    /// top-level keys other than density, strain scale and coeffs (e.g. "strain shift", "meta"), in file order
+    pub extra: serde_json::Map<String, serde_json::Value>,
+}
+
+/// ψ, ∇ψ and ∇²ψ at one strain.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PsiVgh {
+    pub value: f64,
+    pub grad: [f64; 6],
+    pub hess: [[f64; 6]; 6],
+}
+
+/// How the spectral variables w = (u, m, δ, b) depend on z: for each w component up to two (z index, factor).
+type WMap = [[(usize, f64); 2]; 4];
+
+impl Material {
+    /// The (m, δ, b) rows of the w → z map for bending index `kb` (3 or 4); u row left empty.
+    fn bending_map(&self, kb: usize) -> WMap {
+        let inv = 1.0 / self.strain_scale[kb];
+        // [f(L)]₁₁ is [f(L)]₀₀ with δ → −δ
+        let sgn = if kb == 3 { 1.0 } else { -1.0 };
+        [
+            [(0, 0.0), (0, 0.0)],
+            [(3, 0.5 * inv), (5, 0.5 * inv)],
+            [(3, 0.5 * sgn * inv), (5, -0.5 * sgn * inv)],
+            [(4, inv), (4, 0.0)],
+        ]
+    }
+
+    fn w_of(map: &WMap, z: &[f64; 6]) -> [f64; 4] {
+        std::array::from_fn(|a| map[a][0].1 * z[map[a][0].0] + map[a][1].1 * z[map[a][1].0])
+    }
+
+    fn scatter(out: &mut PsiVgh, map: &WMap, s: &spectral::SpectralVgh) {
+        out.value += s.value;
+        for a in 0..4 {
+            for &(i, ca) in &map[a] {
+                if ca == 0.0 {
+                    continue;
+                }
+                out.grad[i] += s.grad[a] * ca;
+                for bidx in 0..4 {
+                    for &(j, cb) in &map[bidx] {
+                        if cb != 0.0 {
+                            out.hess[i][j] += s.hess[a][bidx] * ca * cb;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Fast ψ, ∇ψ, ∇²ψ at z = (s_x, s_a, s_y, II₀₀, II₀₁, II₁₁).
+    pub fn eval(&self, z: &[f64; 6]) -> PsiVgh {
+        let sc = &self.strain_scale;
+        let mut out = PsiVgh {
+            value: self.constant,
+            grad: [0.0; 6],
+            hess: [[0.0; 6]; 6],
+        };
+        for t in &self.terms1d {
+            if t.k <= 2 {
+                let inv = 1.0 / sc[t.k];
+                let [f, f1, f2] = t.spline.eval2(z[t.k] * inv);
+                out.value += f;
+                out.grad[t.k] += f1 * inv;
+                out.hess[t.k][t.k] += f2 * inv * inv;
+            } else {
+                let map = self.bending_map(t.k);
+                let w = Self::w_of(&map, z);
+                let s = spectral_00(&t.spline, w[1], w[2], w[3]);
+                Self::scatter(&mut out, &map, &s);
+            }
+        }
+        for t in &self.terms2d {
+            let iu = 1.0 / sc[t.k0];
+            let u = z[t.k0] * iu;
+            if t.k1 <= 2 {
+                let iv = 1.0 / sc[t.k1];
+                let [f, fu, fv, fuu, fuv, fvv] = t.spline.eval2(u, z[t.k1] * iv);
+                let (a, b) = (t.k0, t.k1);
+                out.value += f;
+                out.grad[a] += fu * iu;
+                out.grad[b] += fv * iv;
+                out.hess[a][a] += fuu * iu * iu;
+                out.hess[b][b] += fvv * iv * iv;
+                out.hess[a][b] += fuv * iu * iv;
+                out.hess[b][a] += fuv * iu * iv;
+            } else {
+                let mut map = self.bending_map(t.k1);
+                map[0] = [(t.k0, iu), (t.k0, 0.0)];
+                let w = Self::w_of(&map, z);
+                let fam = t.spline.at_u(w[0]);
+                let s = spectral_00(&fam, w[1], w[2], w[3]);
+                Self::scatter(&mut out, &map, &s);
+            }
+        }
+        out
+    }
+
+    /// ψ alone (same arithmetic as [`Material::eval`]).
+    pub fn value(&self, z: &[f64; 6]) -> f64 {
+        self.eval(z).value
+    }
+
+    /// Generic reference twin of ψ(z), written from the formula with the Hermite basis evaluated directly.
+    pub fn reference<D: Real>(&self, z: &[D]) -> D {
+        let sc = &self.strain_scale;
+        let mut psi = D::from(self.constant);
+        // spectral variables of bending index kb: (m, δ, b), δ sign-flipped for the 11 component
+        let mdb = |kb: usize| {
+            let s = sc[kb];
+            let sgn = if kb == 3 { 1.0 } else { -1.0 };
+            (
+                (z[3].clone() + z[5].clone()) / (2.0 * s),
+                (z[3].clone() - z[5].clone()) * (sgn / (2.0 * s)),
+                z[4].clone() / s,
+            )
+        };
+        for t in &self.terms1d {
+            if t.k <= 2 {
+                psi += t.spline.reference(&(z[t.k].clone() / sc[t.k]));
+            } else {
+                let (m, delta, b) = mdb(t.k);
+                let sp = &t.spline;
+                let n = sp.t.len();
+                psi += spectral_00_reference(
+                    |x| sp.piece(x),
+                    |x: &D| sp.reference(x),
+                    |index| {
+                        let bp = basis_piece(&sp.t, piece_from_index(n, index));
+                        let i = bp_cell(n, index);
+                        let data = [sp.p[i], sp.p[i + 1], sp.m[i], sp.m[i + 1]];
+                        let cf = std::array::from_fn(|j| {
+                            D::from((0..4).map(|k| bp.w[k][j] * data[k]).sum::<f64>())
+                        });
+                        (cf, bp.origin, bp.h)
+                    },
+                    &m,
+                    &delta,
+                    &b,
+                );
+            }
+        }
+        for t in &self.terms2d {
+            let u = z[t.k0].clone() / sc[t.k0];
+            let sp = &t.spline;
+            if t.k1 <= 2 {
+                psi += sp.reference(&u, &(z[t.k1].clone() / sc[t.k1]));
+            } else {
+                let (m, delta, b) = mdb(t.k1);
+                let (nu, nv) = (sp.tu.len(), sp.tv.len());
+                let (iu, wu) = basis_weights(&sp.tu, &u);
+                psi += spectral_00_reference(
+                    |x| sp.v_piece(x),
+                    |x: &D| sp.reference(&u, x),
+                    |index| {
+                        // f(u, ·) on v piece `index`: Σ_a wu_a(u) Σ_b data[a][b] · (basis b of v in t)
+                        let bp = basis_piece(&sp.tv, piece_from_index(nv, index));
+                        let j = bp_cell(nv, index);
+                        let cf = std::array::from_fn(|jj| {
+                            let mut acc = D::from(0.0);
+                            for (a, wa) in wu.iter().enumerate() {
+                                let (ia, du) =
+                                    [(iu, false), (iu + 1, false), (iu, true), (iu + 1, true)][a];
+                                let mut coef = 0.0;
+                                for bb in 0..4 {
+                                    let (ib, dv) =
+                                        [(j, false), (j + 1, false), (j, true), (j + 1, true)][bb];
+                                    let arr = match (du, dv) {
+                                        (false, false) => &sp.p,
+                                        (true, false) => &sp.mu,
+                                        (false, true) => &sp.mv,
+                                        (true, true) => &sp.muv,
+                                    };
+                                    coef += arr[ib * nu + ia] * bp.w[bb][jj];
+                                }
+                                acc += wa.clone() * coef;
+                            }
+                            acc
+                        });
+                        (cf, bp.origin, bp.h)
+                    },
+                    &m,
+                    &delta,
+                    &b,
+                );
+            }
+        }
+        psi
+    }
+
+    /// Distance (in z units, any single component) to the nearest point where ψ is not C³: a knot of a 1D or 2D
+    /// term along an in-plane axis, or an eigenvalue of L/σ on a bending knot. Eigenvalues move at most as fast as
+    /// the entries of L (Weyl), and L₀₁ enters twice, hence the factor ½ for the bending terms.
+    pub fn kink_distance(&self, z: &[f64; 6]) -> f64 {
+        let sc = &self.strain_scale;
+        let near = |t: &[f64], x: f64| {
+            t.iter()
+                .map(|k| (k - x).abs())
+                .fold(f64::INFINITY, f64::min)
+        };
+        let eig = |kb: usize| {
+            let s = sc[kb];
+            let m = (z[3] + z[5]) / (2.0 * s);
+            let d = (((z[3] - z[5]) / (2.0 * s)).powi(2) + (z[4] / s).powi(2)).sqrt();
+            (m + d, m - d, s)
+        };
+        let mut dist = f64::INFINITY;
+        for t in &self.terms1d {
+            if t.k <= 2 {
+                dist = dist.min(near(&t.spline.t, z[t.k] / sc[t.k]) * sc[t.k]);
+            } else {
+                let (l1, l2, s) = eig(t.k);
+                dist = dist.min(0.5 * s * near(&t.spline.t, l1).min(near(&t.spline.t, l2)));
+            }
+        }
+        for t in &self.terms2d {
+            let sp = &t.spline;
+            dist = dist.min(near(&sp.tu, z[t.k0] / sc[t.k0]) * sc[t.k0]);
+            if t.k1 <= 2 {
+                dist = dist.min(near(&sp.tv, z[t.k1] / sc[t.k1]) * sc[t.k1]);
+            } else {
+                let (l1, l2, s) = eig(t.k1);
+                dist = dist.min(0.5 * s * near(&sp.tv, l1).min(near(&sp.tv, l2)));
+            }
+        }
+        dist
+    }
+
+    /// Knot range [min, max] of strain `k` over all terms that use it (normalised units × σ), for samplers.
+    pub fn knot_range(&self, k: usize) -> (f64, f64) {
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
+        let mut upd = |t: &[f64], s: f64| {
+            lo = lo.min(t[0] * s);
+            hi = hi.max(t[t.len() - 1] * s);
+        };
+        for t in &self.terms1d {
+            if t.k == k {
+                upd(&t.spline.t, self.strain_scale[k]);
+            }
+        }
+        for t in &self.terms2d {
+            if t.k0 == k {
+                upd(&t.spline.tu, self.strain_scale[k]);
+            }
+            if t.k1 == k {
+                upd(&t.spline.tv, self.strain_scale[k]);
+            }
+        }
+        (lo, hi)
+    }
+}
+
+/// The data cell of a piece index on a knot line of `n` knots.
+fn bp_cell(n: usize, index: usize) -> usize {
+    piece_from_index(n, index).cell
+}

@@ -1,0 +1,26 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+
+/// `../shared`, or `None` after printing why the calling test skips.
+pub fn shared_or_skip(test: &str) -> Option<PathBuf> {
+    match hylc::shared_dir() {
+        Some(p) => Some(p),
+        None => {
+            eprintln!("SKIPPED {test}: ../shared (original data and oracles) not found; set HYLC_SHARED to run it");
+            None
+        }
+    }
+}
+
+pub fn rel_norm(a: &[f64], b: &[f64]) -> f64 {
+    let d: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum::<f64>()
+        .sqrt();
+    let n: f64 = b.iter().map(|y| y * y).sum::<f64>().sqrt();
+    d / n.max(f64::MIN_POSITIVE)
+}
