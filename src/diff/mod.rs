@@ -136,7 +136,7 @@ pub struct CheckConfig {
 impl Default for CheckConfig {
     fn default() -> Self {
         CheckConfig {
-            cases: 200,
+            cases: 1000,
             seed: 1,
             tolerances: POLICY,
             fd_step: 1e-3,

@@ -1,8 +1,10 @@
 //! Harness rows for the material (`06-verification.md`, section 1): the 1D and 2D Hermite splines, the bending
 //! matrix-function terms (1D and 2D, both components) and ψ itself.
 //!
-//! Scales (the `scale` of the tolerance test): 1e-6 in the units of each function (J/m² and its derivatives);
-//! it only keeps exact zeros (residual terms on their axes) from dividing by zero.
+//! Scales (the `scale` of the tolerance test, `06-verification.md`): the magnitude of the function's spline data,
+//! V = |C₀| + Σ_terms max|p| (J/m²), because round-off in evaluating a piecewise polynomial is proportional to its
+//! coefficients, not to its value (a residual 2D term is ~1e-8 near its axes while its data are ~1e-2). Gradient
+//! and Hessian scales are V/σ and V/σ² with σ the smallest strain scale among the inputs the function uses.
 
 use super::synthetic::default_material;
 use super::{Hermite1D, Hermite2D, Material};
@@ -11,11 +13,18 @@ use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 
-const SCALES: Scales = Scales {
-    value: 1e-6,
-    gradient: 1e-6,
-    hessian: 1e-6,
-};
+/// Scales for spline data of magnitude `v` on inputs of scale `sigma` (see the module documentation).
+fn data_scales(v: f64, sigma: f64) -> Scales {
+    Scales {
+        value: v,
+        gradient: v / sigma,
+        hessian: v / (sigma * sigma),
+    }
+}
+
+fn max_abs(p: &[f64]) -> f64 {
+    p.iter().fold(0.0, |a, x| a.max(x.abs()))
+}
 
 fn nearest(t: &[f64], x: f64) -> f64 {
     t.iter()
@@ -73,7 +82,7 @@ impl Differentiable for Spline1DCheck {
         1
     }
     fn scales(&self) -> Scales {
-        SCALES
+        data_scales(max_abs(&self.0.p), 1.0)
     }
     fn input_scale(&self, _i: usize) -> f64 {
         0.1
@@ -112,7 +121,7 @@ impl Differentiable for Spline2DCheck {
         2
     }
     fn scales(&self) -> Scales {
-        SCALES
+        data_scales(max_abs(&self.0.p), 1.0)
     }
     fn input_scale(&self, _i: usize) -> f64 {
         0.1
@@ -181,7 +190,18 @@ impl Differentiable for PsiCheck {
         6
     }
     fn scales(&self) -> Scales {
-        SCALES
+        let m = &self.material;
+        let mut v = m.constant.abs();
+        let mut sigma = f64::INFINITY;
+        for t in &m.terms1d {
+            v += max_abs(&t.spline.p);
+            sigma = sigma.min(m.strain_scale[t.k]);
+        }
+        for t in &m.terms2d {
+            v += max_abs(&t.spline.p);
+            sigma = sigma.min(m.strain_scale[t.k0]).min(m.strain_scale[t.k1]);
+        }
+        data_scales(v, sigma)
     }
     fn input_scale(&self, i: usize) -> f64 {
         if i < 3 {
