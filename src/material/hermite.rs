@@ -333,6 +333,17 @@ impl Hermite2D {
         }
     }
 
+    /// Restrict to one u with the polynomial of u piece `upiece` (which need not contain u), for continuity
+    /// checks across grid lines.
+    pub fn at_u_piece(&self, upiece: usize, u: f64) -> AtU<'_> {
+        let pc = &self.pieces[upiece];
+        AtU {
+            spline: self,
+            upiece,
+            s: (u - pc.u0) * pc.ihu,
+        }
+    }
+
     #[inline]
     pub fn v_piece(&self, v: f64) -> usize {
         locate(&self.tv, v).index
