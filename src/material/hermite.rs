@@ -352,8 +352,7 @@ impl Hermite2D {
     /// f, f_u, f_v, f_uu, f_uv, f_vv at (u, v).
     #[inline]
     pub fn eval2(&self, u: f64, v: f64) -> [f64; 6] {
-        let d = self.at_u(u).derivs_on(self.v_piece(v), v);
-        [d[0][0], d[1][0], d[0][1], d[2][0], d[1][1], d[0][2]]
+        self.at_u(u).low_on(self.v_piece(v), v)
     }
 
     /// Generic reference value (tensor product of the Hermite basis weights, extrapolation included).
@@ -407,6 +406,34 @@ impl AtU<'_> {
             poly_derivs(&q[1], t, pc.ihv),
             poly_derivs(&q[2], t, pc.ihv),
         ]
+    }
+
+    /// Derivatives of total order ≤ 2 on v piece `vpiece`: (f, f_u, f_v, f_uu, f_uv, f_vv).
+    #[inline]
+    pub fn low_on(&self, vpiece: usize, v: f64) -> [f64; 6] {
+        let pc = &self.spline.pieces[vpiece * self.spline.nu_pieces + self.upiece];
+        let t = (v - pc.v0) * pc.ihv;
+        let (t2, t3) = (t * t, t * t * t);
+        // r_i = Σ_j c[i][j] tʲ and its first and second t-derivatives
+        let mut r = [0.0; 4];
+        let mut r1 = [0.0; 4];
+        let mut r2 = [0.0; 4];
+        for i in 0..4 {
+            let c = &pc.c[i];
+            r[i] = c[0] + c[1] * t + c[2] * t2 + c[3] * t3;
+            r1[i] = c[1] + 2.0 * c[2] * t + 3.0 * c[3] * t2;
+            r2[i] = 2.0 * c[2] + 6.0 * c[3] * t;
+        }
+        let s = self.s;
+        let (s2, s3) = (s * s, s * s * s);
+        let (iu, iv) = (pc.ihu, pc.ihv);
+        let f = r[0] + r[1] * s + r[2] * s2 + r[3] * s3;
+        let fu = (r[1] + 2.0 * r[2] * s + 3.0 * r[3] * s2) * iu;
+        let fuu = (2.0 * r[2] + 6.0 * r[3] * s) * iu * iu;
+        let fv = (r1[0] + r1[1] * s + r1[2] * s2 + r1[3] * s3) * iv;
+        let fuv = (r1[1] + 2.0 * r1[2] * s + 3.0 * r1[3] * s2) * iu * iv;
+        let fvv = (r2[0] + r2[1] * s + r2[2] * s2 + r2[3] * s3) * iv * iv;
+        [f, fu, fv, fuu, fuv, fvv]
     }
 }
 

@@ -65,42 +65,69 @@ pub struct PsiVgh {
     pub hess: [[f64; 6]; 6],
 }
 
-/// How the spectral variables w = (u, m, δ, b) depend on z: for each w component up to two (z index, factor).
-type WMap = [[(usize, f64); 2]; 4];
-
 impl Material {
-    /// The (m, δ, b) rows of the w → z map for bending index `kb` (3 or 4); u row left empty.
-    fn bending_map(&self, kb: usize) -> WMap {
+    /// Spectral variables (m, δ, b) of bending index `kb` (3 or 4): m = (II₀₀ + II₁₁)/2σ, δ = ±(II₀₀ − II₁₁)/2σ
+    /// (minus for the 11 component: [f(L)]₁₁ is [f(L)]₀₀ with δ → −δ), b = II₀₁/σ.
+    #[inline]
+    fn mdb(&self, kb: usize, z: &[f64; 6]) -> (f64, f64, f64) {
         let inv = 1.0 / self.strain_scale[kb];
-        // [f(L)]₁₁ is [f(L)]₀₀ with δ → −δ
         let sgn = if kb == 3 { 1.0 } else { -1.0 };
-        [
-            [(0, 0.0), (0, 0.0)],
-            [(3, 0.5 * inv), (5, 0.5 * inv)],
-            [(3, 0.5 * sgn * inv), (5, -0.5 * sgn * inv)],
-            [(4, inv), (4, 0.0)],
-        ]
+        (
+            0.5 * inv * (z[3] + z[5]),
+            0.5 * sgn * inv * (z[3] - z[5]),
+            inv * z[4],
+        )
     }
 
-    fn w_of(map: &WMap, z: &[f64; 6]) -> [f64; 4] {
-        std::array::from_fn(|a| map[a][0].1 * z[map[a][0].0] + map[a][1].1 * z[map[a][1].0])
-    }
-
-    fn scatter(out: &mut PsiVgh, map: &WMap, s: &spectral::SpectralVgh) {
+    /// Add a spectral term's value and w-derivatives, w = (u, m, δ, b), to ψ's z-derivatives.
+    /// `u` is (strain index, 1/σ) of the 2D terms' first argument.
+    #[inline]
+    fn add_spectral(
+        &self,
+        out: &mut PsiVgh,
+        kb: usize,
+        u: Option<(usize, f64)>,
+        s: &spectral::SpectralVgh,
+    ) {
+        let inv = 1.0 / self.strain_scale[kb];
+        let c = 0.5 * inv;
+        let sgn = if kb == 3 { c } else { -c };
+        let g = &s.grad;
+        let h = &s.hess;
         out.value += s.value;
-        for a in 0..4 {
-            for &(i, ca) in &map[a] {
-                if ca == 0.0 {
-                    continue;
-                }
-                out.grad[i] += s.grad[a] * ca;
-                for bidx in 0..4 {
-                    for &(j, cb) in &map[bidx] {
-                        if cb != 0.0 {
-                            out.hess[i][j] += s.hess[a][bidx] * ca * cb;
-                        }
-                    }
-                }
+        // z-gradient: ∂/∂II₀₀ = c g_m + sgn g_δ, ∂/∂II₁₁ = c g_m − sgn g_δ, ∂/∂II₀₁ = g_b/σ, ∂/∂z_k = g_u/σ_k
+        out.grad[3] += c * g[1] + sgn * g[2];
+        out.grad[5] += c * g[1] - sgn * g[2];
+        out.grad[4] += inv * g[3];
+        // T_j = H R_j for the z directions R_j of II₀₀, II₀₁, II₁₁ (and z_k); H_z[i][j] = R_i · T_j
+        let col = |j: usize| [h[0][j], h[1][j], h[2][j], h[3][j]];
+        let comb = |a: [f64; 4], ca: f64, b: [f64; 4], cb: f64| -> [f64; 4] {
+            std::array::from_fn(|i| ca * a[i] + cb * b[i])
+        };
+        let (c1, c2, c3) = (col(1), col(2), col(3));
+        let t3 = comb(c1, c, c2, sgn);
+        let t5 = comb(c1, c, c2, -sgn);
+        let t4 = comb(c3, inv, c3, 0.0);
+        let dot = |t: &[f64; 4], i: usize| -> f64 {
+            match i {
+                3 => c * t[1] + sgn * t[2],
+                5 => c * t[1] - sgn * t[2],
+                _ => inv * t[3],
+            }
+        };
+        for (j, t) in [(3, &t3), (4, &t4), (5, &t5)] {
+            for i in 3..6 {
+                out.hess[i][j] += dot(t, i);
+            }
+        }
+        if let Some((k, iu)) = u {
+            out.grad[k] += iu * g[0];
+            let tk = comb(col(0), iu, col(0), 0.0);
+            out.hess[k][k] += iu * tk[0];
+            for i in 3..6 {
+                let v = dot(&tk, i);
+                out.hess[i][k] += v;
+                out.hess[k][i] += v;
             }
         }
     }
@@ -121,10 +148,9 @@ impl Material {
                 out.grad[t.k] += f1 * inv;
                 out.hess[t.k][t.k] += f2 * inv * inv;
             } else {
-                let map = self.bending_map(t.k);
-                let w = Self::w_of(&map, z);
-                let s = spectral_00(&t.spline, w[1], w[2], w[3]);
-                Self::scatter(&mut out, &map, &s);
+                let (m, d, b) = self.mdb(t.k, z);
+                let s = spectral_00(&t.spline, m, d, b);
+                self.add_spectral(&mut out, t.k, None, &s);
             }
         }
         for t in &self.terms2d {
@@ -142,12 +168,9 @@ impl Material {
                 out.hess[a][b] += fuv * iu * iv;
                 out.hess[b][a] += fuv * iu * iv;
             } else {
-                let mut map = self.bending_map(t.k1);
-                map[0] = [(t.k0, iu), (t.k0, 0.0)];
-                let w = Self::w_of(&map, z);
-                let fam = t.spline.at_u(w[0]);
-                let s = spectral_00(&fam, w[1], w[2], w[3]);
-                Self::scatter(&mut out, &map, &s);
+                let (m, d, b) = self.mdb(t.k1, z);
+                let s = spectral_00(&t.spline.at_u(u), m, d, b);
+                self.add_spectral(&mut out, t.k1, Some((t.k0, iu)), &s);
             }
         }
         out

@@ -32,6 +32,8 @@ pub trait LambdaFamily {
     fn piece(&self, lambda: f64) -> usize;
     /// `d[a][b]` = ∂ᵃ_u ∂ᵇ_λ φ for a ≤ 2, b ≤ 3, with the polynomial of `piece` (λ need not lie on it).
     fn derivs_on(&self, piece: usize, lambda: f64) -> Derivs2;
+    /// Derivatives of total order ≤ 2 on `piece`: (φ, φ_u, φ_λ, φ_uu, φ_uλ, φ_λλ).
+    fn low_on(&self, piece: usize, lambda: f64) -> [f64; 6];
 }
 
 impl LambdaFamily for Hermite1D {
@@ -47,6 +49,11 @@ impl LambdaFamily for Hermite1D {
             [0.0; 4],
         ]
     }
+    #[inline]
+    fn low_on(&self, piece: usize, lambda: f64) -> [f64; 6] {
+        let d = Hermite1D::derivs_on(self, piece, lambda);
+        [d[0], 0.0, d[1], 0.0, 0.0, d[2]]
+    }
 }
 
 impl LambdaFamily for super::hermite::AtU<'_> {
@@ -57,6 +64,10 @@ impl LambdaFamily for super::hermite::AtU<'_> {
     #[inline]
     fn derivs_on(&self, piece: usize, lambda: f64) -> Derivs2 {
         super::hermite::AtU::derivs_on(self, piece, lambda)
+    }
+    #[inline]
+    fn low_on(&self, piece: usize, lambda: f64) -> [f64; 6] {
+        super::hermite::AtU::low_on(self, piece, lambda)
     }
 }
 
@@ -103,10 +114,20 @@ pub fn spectral_00<F: LambdaFamily>(f: &F, m: f64, delta: f64, b: f64) -> Spectr
         ];
         (g, gy, hy, true)
     } else {
-        let a = f.derivs_on(p1, l1);
-        let bb = f.derivs_on(p2, l2);
-        let half_sum = |i: usize, j: usize| 0.5 * (a[i][j] + bb[i][j]);
-        let half_dif = |i: usize, j: usize| 0.5 * (a[i][j] - bb[i][j]);
+        // (φ, φ_u, φ_λ, φ_uu, φ_uλ, φ_λλ) at λ₁ and λ₂: only total order ≤ 2 enters
+        let a = f.low_on(p1, l1);
+        let bb = f.low_on(p2, l2);
+        // positions in `low_on`'s output of ∂ᵃ_u ∂ᵇ_λ, keyed (a, b)
+        let at = |i: usize, j: usize| match (i, j) {
+            (0, 0) => 0,
+            (1, 0) => 1,
+            (0, 1) => 2,
+            (2, 0) => 3,
+            (1, 1) => 4,
+            _ => 5,
+        };
+        let half_sum = |i: usize, j: usize| 0.5 * (a[at(i, j)] + bb[at(i, j)]);
+        let half_dif = |i: usize, j: usize| 0.5 * (a[at(i, j)] - bb[at(i, j)]);
         // c₀(u, m, d) and its derivatives (λ₁ = m + d, λ₂ = m − d)
         let c0 = half_sum(0, 0);
         let (c0u, c0m, c0d) = (half_sum(1, 0), half_sum(0, 1), half_dif(0, 1));
@@ -164,37 +185,25 @@ pub fn spectral_00<F: LambdaFamily>(f: &F, m: f64, delta: f64, b: f64) -> Spectr
             delta * delta * id3,
         )
     };
-    // columns of J = ∂y/∂w
-    let jcol = |k: usize| -> [f64; 4] {
-        match k {
-            0 => [1.0, 0.0, 0.0, 0.0],
-            1 => [0.0, 1.0, 0.0, 0.0],
-            2 => [0.0, 0.0, sd, 1.0],
-            _ => [0.0, 0.0, sb, 0.0],
-        }
-    };
-    let mut out = SpectralVgh {
+    // H_w = Jᵀ H_y J + G_s ∇²s with J = ∂y/∂w: columns e_u, e_m, s_δ e_s + e_δ, s_b e_s
+    let h = &hy;
+    let gs = gy[2];
+    let h02 = h[0][2] * sd + h[0][3];
+    let h12 = h[1][2] * sd + h[1][3];
+    let h22 = h[2][2] * sd * sd + 2.0 * h[2][3] * sd + h[3][3] + gs * sdd;
+    let h23 = (h[2][2] * sd + h[2][3]) * sb + gs * sdb;
+    let h33 = h[2][2] * sb * sb + gs * sbb;
+    let (h03, h13) = (h[0][2] * sb, h[1][2] * sb);
+    SpectralVgh {
         value: g,
-        grad: [gy[0], gy[1], gy[2] * sd + gy[3], gy[2] * sb],
-        hess: [[0.0; 4]; 4],
-    };
-    let cols = [jcol(0), jcol(1), jcol(2), jcol(3)];
-    for i in 0..4 {
-        let mut hi = [0.0; 4];
-        for (k, hik) in hi.iter_mut().enumerate() {
-            *hik = (0..4).map(|l| hy[k][l] * cols[i][l]).sum();
-        }
-        for j in i..4 {
-            let v: f64 = (0..4).map(|k| cols[j][k] * hi[k]).sum();
-            out.hess[i][j] = v;
-            out.hess[j][i] = v;
-        }
+        grad: [gy[0], gy[1], gs * sd + gy[3], gs * sb],
+        hess: [
+            [h[0][0], h[0][1], h02, h03],
+            [h[0][1], h[1][1], h12, h13],
+            [h02, h12, h22, h23],
+            [h03, h13, h23, h33],
+        ],
     }
-    out.hess[2][2] += gy[2] * sdd;
-    out.hess[2][3] += gy[2] * sdb;
-    out.hess[3][2] += gy[2] * sdb;
-    out.hess[3][3] += gy[2] * sbb;
-    out
 }
 
 /// Generic reference twin of [`spectral_00`]: [φ(L)]₀₀ = c₀ + c₁ δ with c₀, c₁ written as symmetric functions of
