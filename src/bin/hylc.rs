@@ -233,6 +233,9 @@ fn fmt_row(v: &[f64]) -> String {
         .join(" ")
 }
 
+/// A strain sweep: name, z(t), t range.
+type Sweep = (&'static str, fn(f64) -> [f64; 6], f64, f64);
+
 /// The material demo: what `run` does until the end-to-end pipeline exists.
 fn run_demo(out: &Path) -> Result<ExitCode, String> {
     std::fs::create_dir_all(out).map_err(|e| format!("{}: cannot create: {e}", out.display()))?;
@@ -254,7 +257,7 @@ fn run_demo(out: &Path) -> Result<ExitCode, String> {
         path.display()
     );
     // sweeps: uniaxial stretch, shear, x-bending, an umbilic (equal principal curvature) sweep
-    let sweeps: [(&str, fn(f64) -> [f64; 6], f64, f64); 4] = [
+    let sweeps: [Sweep; 4] = [
         ("stretch s_x", |t| [t, 0.0, 0.0, 0.0, 0.0, 0.0], -0.5, 1.0),
         ("shear s_a", |t| [0.0, t, 0.0, 0.0, 0.0, 0.0], -0.7, 0.7),
         (

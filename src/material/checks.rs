@@ -271,6 +271,9 @@ pub fn sample_strain(m: &Material, rng: &mut ChaCha8Rng, i: usize) -> Vec<f64> {
     z
 }
 
+/// A single-term harness row: name, 1D terms kept, 2D terms kept.
+type TermRow<'a> = (&'a str, &'a [usize], &'a [(usize, usize)]);
+
 /// The material rows of the harness: splines, bending terms and ψ of the embedded default material, and ψ of
 /// the original materials when `../shared` is present.
 pub fn diff_checks() -> Vec<Box<dyn Check>> {
@@ -279,7 +282,7 @@ pub fn diff_checks() -> Vec<Box<dyn Check>> {
         Box::new(Spline1DCheck(test_spline1d())),
         Box::new(Spline2DCheck(test_spline2d())),
     ];
-    let rows: [(&str, &[usize], &[(usize, usize)]); 4] = [
+    let rows: [TermRow; 4] = [
         ("bending1d [f3(L)]00", &[3], &[]),
         ("bending1d [f4(L)]11", &[4], &[]),
         ("bending2d [f03(u,L)]00", &[], &[(0, 3)]),

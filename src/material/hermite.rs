@@ -44,19 +44,30 @@ pub fn piece_from_index(n: usize, index: usize) -> Piece {
 }
 
 /// Locate `x` on strictly increasing knots `t` (at least two). NaN lands in the first cell (and stays NaN).
+///
+/// The cell is guessed by linear interpolation over the knot range (exact for uniform knots, off by a few for the
+/// originals' two-spacing grids) and then corrected, so the result is always the cell with tᵢ ≤ x < tᵢ₊₁.
 #[inline]
 pub fn locate(t: &[f64], x: f64) -> Piece {
     let n = t.len();
-    if x < t[0] {
+    let (first, last) = (t[0], t[n - 1]);
+    if x < first {
         Piece { index: 0, cell: 0 }
-    } else if x > t[n - 1] {
+    } else if x > last {
         Piece {
             index: n,
             cell: n - 2,
         }
     } else {
-        // number of knots ≤ x, minus one, is the cell; x = t_{n−1} belongs to the last cell
-        let cell = t.partition_point(|&tk| tk <= x).clamp(1, n - 1) - 1;
+        // x = t_{n−1} belongs to the last cell; NaN fails both comparisons above and the guess is 0
+        let guess = ((x - first) / (last - first) * (n - 1) as f64) as usize;
+        let mut cell = guess.min(n - 2);
+        while cell > 0 && t[cell] > x {
+            cell -= 1;
+        }
+        while cell < n - 2 && t[cell + 1] <= x {
+            cell += 1;
+        }
         Piece {
             index: cell + 1,
             cell,
@@ -469,6 +480,20 @@ mod tests {
         assert!((s.eval2(-2.0)[0] - (3.0 + 2.0)).abs() < 1e-14);
         assert_eq!(s.eval2(-2.0)[2], 0.0);
         assert!((s.eval2(3.0)[0] - (5.0 + 4.0)).abs() < 1e-14);
+    }
+
+    #[test]
+    fn locate_agrees_with_bisection_on_uneven_knots() {
+        let t = [-0.9, -0.85, -0.3, 0.0, 0.01, 0.5, 2.0];
+        for k in 0..=3000 {
+            let x = -0.9 + 2.9 * k as f64 / 3000.0;
+            let cell = t.partition_point(|&tk| tk <= x).clamp(1, t.len() - 1) - 1;
+            assert_eq!(locate(&t, x).cell, cell, "x = {x}");
+        }
+        for &x in &t {
+            let cell = t.partition_point(|&tk| tk <= x).clamp(1, t.len() - 1) - 1;
+            assert_eq!(locate(&t, x).cell, cell, "knot {x}");
+        }
     }
 
     #[test]

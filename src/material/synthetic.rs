@@ -45,17 +45,19 @@ fn coupling(k0: usize, k1: usize) -> f64 {
     }
 }
 
-fn knots(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    (0..n)
-        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
-        .collect()
+/// `n` knots with spacing `h`, `neg` of them below 0 and 0 itself a knot (exactly: multiples of h).
+fn knots(neg: usize, h: f64, n: usize) -> Vec<f64> {
+    (0..n).map(|i| (i as f64 - neg as f64) * h).collect()
 }
 
-/// Knot line of strain k in normalised units (in-plane stretch denser in compression range like the originals).
+/// Knot line of strain k in normalised units, 0 always a knot (so every term is exactly 0 at z = 0):
+/// in-plane stretch on about [−0.6, 0.9], shear and bending on about [−0.95, 0.95].
 fn line(k: usize, n: usize) -> Vec<f64> {
-    match k {
-        0 | 2 => knots(-0.6, 0.9, n),
-        _ => knots(-0.95, 0.95, n),
+    match (k, n) {
+        (0 | 2, 11) => knots(4, 0.15, 11),
+        (0 | 2, _) => knots(3, 0.2, n),
+        (_, 11) => knots(5, 0.19, 11),
+        _ => knots(n / 2, 0.95 / (n / 2) as f64, n),
     }
 }
 
