@@ -65,55 +65,36 @@ impl Differentiable for MissingChainFactor {
     }
 }
 
-/// Mutant 2: ψ's gradient with the II01 entry halved (forgetting that L01 appears twice in a symmetric L).
-struct HalvedOffDiagonal(PsiCheck);
+/// ψ with a deliberate edit of its fast gradient or Hessian (mutants 2 and 3).
+struct PsiMutant {
+    name: &'static str,
+    inner: PsiCheck,
+    edit: fn(&mut Vgh),
+}
 
-impl Differentiable for HalvedOffDiagonal {
+impl Differentiable for PsiMutant {
     fn name(&self) -> String {
-        "mutant: psi dpsi/dII01 halved".into()
+        self.name.into()
     }
     fn dim(&self) -> usize {
         6
     }
     fn reference<D: Real>(&self, x: &[D]) -> D {
-        self.0.reference(x)
+        self.inner.reference(x)
     }
     fn fast(&self, x: &[f64]) -> Vgh {
-        let mut r = self.0.fast(x);
-        r.gradient[4] *= 0.5;
+        let mut r = self.inner.fast(x);
+        (self.edit)(&mut r);
         r
     }
     fn fast_value(&self, x: &[f64]) -> f64 {
-        self.0.fast_value(x)
+        self.inner.fast_value(x)
     }
     fn kink_distance(&self, x: &[f64]) -> f64 {
-        self.0.kink_distance(x)
+        self.inner.kink_distance(x)
     }
     fn sample(&self, rng: &mut ChaCha8Rng, i: usize) -> Vec<f64> {
-        sample_strain(&self.0.material, rng, i)
-    }
-}
-
-/// Mutant 3: a Hessian entry off by one part in a million (small, but far above the 1e-8 AD tolerance).
-struct TinyHessianError(PsiCheck);
-
-impl Differentiable for TinyHessianError {
-    fn name(&self) -> String {
-        "mutant: psi d2psi/dsx dsy * (1 + 1e-6)".into()
-    }
-    fn dim(&self) -> usize {
-        6
-    }
-    fn reference<D: Real>(&self, x: &[D]) -> D {
-        self.0.reference(x)
-    }
-    fn fast(&self, x: &[f64]) -> Vgh {
-        let mut r = self.0.fast(x);
-        r.hessian[(0, 0)] *= 1.0 + 1e-6;
-        r
-    }
-    fn sample(&self, rng: &mut ChaCha8Rng, i: usize) -> Vec<f64> {
-        sample_strain(&self.0.material, rng, i)
+        sample_strain(&self.inner.material, rng, i)
     }
 }
 
@@ -133,10 +114,22 @@ fn wrong_derivatives_are_caught() {
     let r = check_function(&MissingChainFactor(test_spline1d()), &cfg);
     assert!(!r.passed() && r.failures > 30, "mutant 1 not caught: {r:?}");
     assert!(r.max_hessian_ad > 1e-2 && r.max_hessian_fd > 1e-2);
-    let r = check_function(&HalvedOffDiagonal(psi_default()), &cfg);
+    // mutant 2: dψ/dII01 halved (forgetting that L01 appears twice in a symmetric L)
+    let halved = PsiMutant {
+        name: "mutant: psi dpsi/dII01 halved",
+        inner: psi_default(),
+        edit: |r| r.gradient[4] *= 0.5,
+    };
+    let r = check_function(&halved, &cfg);
     assert!(!r.passed(), "mutant 2 not caught: {r:?}");
     assert!(r.max_gradient_ad > 1e-9 && r.max_gradient_fd > 1e-6);
-    let r = check_function(&TinyHessianError(psi_default()), &cfg);
+    // mutant 3: one Hessian entry off by one part in a million (far above the 1e-8 AD tolerance)
+    let tiny = PsiMutant {
+        name: "mutant: psi d2psi/dsx2 * (1 + 1e-6)",
+        inner: psi_default(),
+        edit: |r| r.hessian[(0, 0)] *= 1.0 + 1e-6,
+    };
+    let r = check_function(&tiny, &cfg);
     assert!(
         !r.passed() && r.max_hessian_ad > 1e-8,
         "mutant 3 not caught: {r:?}"
