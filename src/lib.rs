@@ -6,6 +6,7 @@
 
 pub mod diff;
 pub mod material;
+pub mod pattern;
 
 use std::path::PathBuf;
 
