@@ -7,6 +7,7 @@
 pub mod diff;
 pub mod material;
 pub mod pattern;
+pub mod rod;
 
 use std::path::PathBuf;
 
