@@ -92,19 +92,35 @@ pub struct Vgh {
 pub trait Differentiable: Sync {
     /// Row name in the report.
     fn name(&self) -> String;
-    /// Number of inputs.
+    /// Number of inputs (the variables the derivatives are taken with respect to).
     fn dim(&self) -> usize;
+    /// Number of fixed parameters that follow the `dim()` inputs in every sampled vector (stored frames, rest
+    /// values, stiffnesses): passed to `reference` and `fast` but never differentiated or perturbed.
+    fn n_params(&self) -> usize {
+        0
+    }
     /// Magnitudes for the tolerance test (document the choice in the implementation).
     fn scales(&self) -> Scales {
         Scales::default()
+    }
+    /// Scales at a particular input (for functions whose natural magnitudes depend on the sample, such as rod
+    /// stencils with edges from 1e-3 r to 1e3 r); defaults to [`Differentiable::scales`].
+    fn scales_at(&self, _x: &[f64]) -> Scales {
+        self.scales()
     }
     /// Typical magnitude of input `i`; finite-difference steps are relative to it.
     fn input_scale(&self, _i: usize) -> f64 {
         1.0
     }
-    /// The plain reference implementation of the value, generic over the scalar.
+    /// Typical magnitude of input `i` at a particular input `x`; defaults to [`Differentiable::input_scale`].
+    fn input_scale_at(&self, _x: &[f64], i: usize) -> f64 {
+        self.input_scale(i)
+    }
+    /// The plain reference implementation of the value, generic over the scalar. `x` holds the `dim()` inputs
+    /// followed by the `n_params()` parameters (as constants of type `D`).
     fn reference<D: Real>(&self, x: &[D]) -> D;
-    /// The fast hand-written value, gradient and Hessian.
+    /// The fast hand-written value, gradient and Hessian with respect to the first `dim()` entries of `x` (the
+    /// parameters follow them).
     fn fast(&self, x: &[f64]) -> Vgh;
     /// Fast value only (used by finite differences); defaults to [`Differentiable::fast`].
     fn fast_value(&self, x: &[f64]) -> f64 {
@@ -116,7 +132,7 @@ pub trait Differentiable: Sync {
     fn kink_distance(&self, _x: &[f64]) -> f64 {
         f64::INFINITY
     }
-    /// The `i`-th random test input. Implementations cycle through their categories of inputs (generic, extremes,
+    /// The `i`-th random test input (`dim()` inputs, then `n_params()` parameters). Implementations cycle through their categories of inputs (generic, extremes,
     /// singular points) with `i`.
     fn sample(&self, rng: &mut ChaCha8Rng, i: usize) -> Vec<f64>;
 }
@@ -179,10 +195,12 @@ pub fn rel_err(a: &[f64], b: &[f64], scale: f64) -> f64 {
 
 /// Value, gradient and Hessian of the reference implementation by num-dual (second-order dual numbers).
 pub fn reference_ad<F: Differentiable + ?Sized>(f: &F, x: &[f64]) -> Vgh {
-    let xv = DVector::from_column_slice(x);
+    let n = f.dim();
+    let xv = DVector::from_column_slice(&x[..n]);
     let (value, gradient, hessian) = num_dual::hessian(
         |xd: DVector<Dual2DVec64>| {
-            let v: Vec<Dual2DVec64> = xd.iter().cloned().collect();
+            let mut v: Vec<Dual2DVec64> = xd.iter().cloned().collect();
+            v.extend(x[n..].iter().map(|&p| Dual2DVec64::from(p)));
             f.reference(&v)
         },
         &xv,
@@ -226,7 +244,7 @@ impl CaseErrors {
 
 /// Compare fast and reference implementations at one input.
 pub fn check_case<F: Differentiable + ?Sized>(f: &F, x: &[f64], cfg: &CheckConfig) -> CaseErrors {
-    let s = f.scales();
+    let s = f.scales_at(x);
     let fast = f.fast(x);
     let xr: Vec<f64> = x.to_vec();
     let ref_value = f.reference::<f64>(&xr);
@@ -235,7 +253,7 @@ pub fn check_case<F: Differentiable + ?Sized>(f: &F, x: &[f64], cfg: &CheckConfi
     let gradient_ad = rel_err(fast.gradient.as_slice(), ad.gradient.as_slice(), s.gradient);
     let hessian_ad = rel_err(fast.hessian.as_slice(), ad.hessian.as_slice(), s.hessian);
     let steps: Vec<f64> = (0..f.dim())
-        .map(|i| cfg.fd_step * f.input_scale(i))
+        .map(|i| cfg.fd_step * f.input_scale_at(x, i))
         .collect();
     let kink = f.kink_distance(x);
     // The Richardson stencil reaches ±h; stay strictly inside the smooth region.
@@ -245,8 +263,14 @@ pub fn check_case<F: Differentiable + ?Sized>(f: &F, x: &[f64], cfg: &CheckConfi
         .min(1.0);
     let (gradient_fd, hessian_fd) = if shrink * cfg.fd_step >= cfg.fd_min_step {
         let h: Vec<f64> = steps.iter().map(|h| h * shrink).collect();
-        let g = fd_gradient(|y| f.fast_value(y), x, &h);
-        let hh = fd_hessian(|y| f.fast(y).gradient, x, &h);
+        let n = f.dim();
+        let full = |y: &[f64]| {
+            let mut v = y.to_vec();
+            v.extend_from_slice(&x[n..]);
+            v
+        };
+        let g = fd_gradient(|y| f.fast_value(&full(y)), &x[..n], &h);
+        let hh = fd_hessian(|y| f.fast(&full(y)).gradient, &x[..n], &h);
         (
             Some(rel_err(fast.gradient.as_slice(), g.as_slice(), s.gradient)),
             Some(rel_err(fast.hessian.as_slice(), hh.as_slice(), s.hessian)),
@@ -292,6 +316,7 @@ fn fxhash(s: &str) -> u64 {
 pub fn registry() -> Vec<Box<dyn Check>> {
     let mut checks: Vec<Box<dyn Check>> = Vec::new();
     checks.extend(crate::material::diff_checks());
+    checks.extend(crate::rod::diff_checks());
     checks
 }
 

@@ -1,6 +1,14 @@
 //! Discrete elastic rods (`../shared/design/02-yarn-model.md`, "Discrete elastic rods"; Bergou et al. 2008,
 //! 2010): frames, parallel transport, reference twist, and the stretching and bending+twisting stencils.
 
+pub mod bend_twist;
+mod checks;
+pub mod frame;
+pub mod generic;
+pub mod jet;
 mod material;
+pub mod stretch;
 
+pub use bend_twist::{BendTwistParams, StencilFrames};
+pub use checks::diff_checks;
 pub use material::YarnMaterial;
