@@ -132,6 +132,11 @@ pub trait Differentiable: Sync {
     fn kink_distance(&self, _x: &[f64]) -> f64 {
         f64::INFINITY
     }
+    /// The same for input `i` alone, for functions whose inputs have different units (positions and angles);
+    /// defaults to [`Differentiable::kink_distance`].
+    fn kink_distance_of(&self, x: &[f64], _i: usize) -> f64 {
+        self.kink_distance(x)
+    }
     /// The `i`-th random test input (`dim()` inputs, then `n_params()` parameters). Implementations cycle through their categories of inputs (generic, extremes,
     /// singular points) with `i`.
     fn sample(&self, rng: &mut ChaCha8Rng, i: usize) -> Vec<f64>;
@@ -255,11 +260,13 @@ pub fn check_case<F: Differentiable + ?Sized>(f: &F, x: &[f64], cfg: &CheckConfi
     let steps: Vec<f64> = (0..f.dim())
         .map(|i| cfg.fd_step * f.input_scale_at(x, i))
         .collect();
-    let kink = f.kink_distance(x);
     // The Richardson stencil reaches ±h; stay strictly inside the smooth region.
     let shrink = steps
         .iter()
-        .fold(1.0_f64, |acc, &h| acc.min(0.5 * kink / h))
+        .enumerate()
+        .fold(1.0_f64, |acc, (i, &h)| {
+            acc.min(0.5 * f.kink_distance_of(x, i) / h)
+        })
         .min(1.0);
     let (gradient_fd, hessian_fd) = if shrink * cfg.fd_step >= cfg.fd_min_step {
         let h: Vec<f64> = steps.iter().map(|h| h * shrink).collect();

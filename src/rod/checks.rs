@@ -175,11 +175,14 @@ impl Differentiable for BendTwistCheck {
     }
     /// Near a fold (turning angle φ → π) the energy varies on the length scale (π − φ) L; finite differences stay
     /// well inside it.
-    fn kink_distance(&self, x: &[f64]) -> f64 {
+    fn kink_distance_of(&self, x: &[f64], i: usize) -> f64 {
+        if i >= 9 {
+            return f64::INFINITY;
+        }
         let (p, _) = unpack(x);
         let (e0, e1) = (p[1] - p[0], p[2] - p[1]);
         let phi = e0.angle(&e1);
-        0.1 * shortest_edge(x) * (PI - phi).min(1.0)
+        0.01 * shortest_edge(x) * (PI - phi).min(1.0)
     }
     fn reference<D: Real>(&self, x: &[D]) -> D {
         let xf: Vec<f64> = x.iter().map(|v| v.re()).collect();
