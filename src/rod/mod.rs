@@ -7,8 +7,13 @@ pub mod frame;
 pub mod generic;
 pub mod jet;
 mod material;
+pub mod state;
 pub mod stretch;
 
 pub use bend_twist::{BendTwistParams, StencilFrames};
 pub use checks::diff_checks;
 pub use material::YarnMaterial;
+pub use state::{
+    raw_reference_twists, set_rest_to_current, Placement, RodState, RodTopology, StencilDofs,
+    Translation,
+};
