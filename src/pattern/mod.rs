@@ -12,6 +12,10 @@
 
 use nalgebra::Vector3;
 
+pub mod pyp;
+
+pub use pyp::{PatternError, PatternWarning, PeriodMismatch};
+
 /// One periodic tile of yarn (the data of a `.pyp` file).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Pattern {
