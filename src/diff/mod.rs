@@ -137,6 +137,11 @@ pub trait Differentiable: Sync {
     fn kink_distance_of(&self, x: &[f64], _i: usize) -> f64 {
         self.kink_distance(x)
     }
+    /// Number of cases to run when `requested` are asked for: expensive functions (a whole tile with hundreds of
+    /// inputs) cap it; defaults to `requested`.
+    fn cases(&self, requested: usize) -> usize {
+        requested
+    }
     /// The `i`-th random test input (`dim()` inputs, then `n_params()` parameters). Implementations cycle through their categories of inputs (generic, extremes,
     /// singular points) with `i`.
     fn sample(&self, rng: &mut ChaCha8Rng, i: usize) -> Vec<f64>;
@@ -300,7 +305,7 @@ pub fn check_function<F: Differentiable + ?Sized>(f: &F, cfg: &CheckConfig) -> R
     let seed = cfg.seed ^ fxhash(&name);
     let inputs: Vec<Vec<f64>> = {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        (0..cfg.cases).map(|i| f.sample(&mut rng, i)).collect()
+        (0..f.cases(cfg.cases)).map(|i| f.sample(&mut rng, i)).collect()
     };
     let results: Vec<(Vec<f64>, CaseErrors)> = inputs
         .into_par_iter()
