@@ -825,7 +825,7 @@ pub fn min_centerline_distance(p: &Pattern, same_yarn: SameYarn) -> MinDistance 
                     if let Some(sep) = separation(a, b, o) {
                         match same_yarn {
                             SameYarn::Skip => continue,
-                            SameYarn::ExcludeNeighbours(k) if sep <= k as i64 => continue,
+                            SameYarn::ExcludeNeighbours(k) if sep as u64 <= k as u64 => continue,
                             _ => {}
                         }
                     }
