@@ -3,8 +3,9 @@
 //! twill/satin/basket) and a stockinette knit, as smooth periodic centre-line curves sampled at about one vertex per
 //! yarn radius").
 //!
-//! Every generator builds smooth periodic centre lines, samples each yarn at equal arclength with
-//! `max(4, round(L · vertices_per_radius / r))` vertices (L: the yarn's length per tile), wraps the vertices into the
+//! Every generator builds smooth periodic centre lines, samples each yarn at about equal arclength with about
+//! `round(L · vertices_per_radius / r)` vertices, at least 4 (L: the yarn's length per tile; weave yarns are sampled
+//! crossing by crossing with a vertex on every crossing, knit yarns loop by loop), wraps the vertices into the
 //! tile [−p₁/2, p₁/2) × [−p₂/2, p₂/2) (edges that leave the tile end at the periodic copy, offsets in {−1, 0, 1}),
 //! shifts all positions so that their length-weighted (Voronoi) mean is 0, sets θ = 0, chooses reference directors
 //! smoothly by parallel transport along each yarn (the closing mismatch of a closed yarn is absorbed by the
