@@ -23,7 +23,8 @@ const NAMES: [&str; 5] = [
 
 fn load(name: &str) -> Option<Pattern> {
     let dir = common::shared_or_skip("rod_conventions")?.join("data/hylc2020/patterns");
-    let (p, _) = Pattern::load_pyp(dir.join(format!("{name}.pyp"))).expect("original pattern loads");
+    let (p, _) =
+        Pattern::load_pyp(dir.join(format!("{name}.pyp"))).expect("original pattern loads");
     Some(p)
 }
 
@@ -49,12 +50,18 @@ fn stored_reference_twists_are_reproduced() {
             // the periods its rest lengths imply
             let implied = p.implied_periods().expect("basket has periodic edges");
             let (max, _) = twist_errors(&p);
-            assert!(max > 1e-4, "basket with stored periods should not match: {max:e}");
+            assert!(
+                max > 1e-4,
+                "basket with stored periods should not match: {max:e}"
+            );
             p.periods = implied;
         }
         let (max, rms) = twist_errors(&p);
         println!("{name}: reference twist error max {max:.2e} rms {rms:.2e} rad");
-        assert!(max <= 2e-5 && rms <= 2e-6, "{name}: max {max:e}, rms {rms:e}");
+        assert!(
+            max <= 2e-5 && rms <= 2e-6,
+            "{name}: max {max:e}, rms {rms:e}"
+        );
     }
 }
 
@@ -90,28 +97,35 @@ fn stored_rest_curvatures_follow_the_conventions() {
         }
         let state = RodState::from_pattern(&p);
         let topo = RodTopology::new(&p);
-        let kin = state.kinematics(
-            &topo,
-            &Translation {
-                periods: p.periods,
-            },
-        );
+        let kin = state.kinematics(&topo, &Translation { periods: p.periods });
         let measured: Vec<f64> = kin.iter().flat_map(|k| k.curvature).collect();
         let stored: Vec<f64> = p.rest_curvature.iter().flatten().copied().collect();
         let (corr, ratio) = corr_ratio(&measured, &stored);
         // swapping the two curvature components (a convention error) destroys the agreement
-        let swapped: Vec<f64> = kin.iter().flat_map(|k| [k.curvature[1], k.curvature[0]]).collect();
+        let swapped: Vec<f64> = kin
+            .iter()
+            .flat_map(|k| [k.curvature[1], k.curvature[0]])
+            .collect();
         let (corr_swapped, _) = corr_ratio(&swapped, &stored);
         println!(
             "{name}: rest curvature correlation {corr:.4}, ratio {ratio:.3} (components swapped: {corr_swapped:.3})"
         );
-        assert!(corr_swapped < 0.5, "{name}: swapped correlation {corr_swapped}");
+        assert!(
+            corr_swapped < 0.5,
+            "{name}: swapped correlation {corr_swapped}"
+        );
         match name {
             "basket" | "satin" => {
-                assert!(corr > 0.99 && (0.85..0.95).contains(&ratio), "{name}: {corr} {ratio}")
+                assert!(
+                    corr > 0.99 && (0.85..0.95).contains(&ratio),
+                    "{name}: {corr} {ratio}"
+                )
             }
             "slip_stitch_honeycomb" => {
-                assert!(corr > 0.98 && (0.85..0.95).contains(&ratio), "{name}: {corr} {ratio}")
+                assert!(
+                    corr > 0.98 && (0.85..0.95).contains(&ratio),
+                    "{name}: {corr} {ratio}"
+                )
             }
             // the tight knits are not equilibria of the stored rest shape (02-yarn-model.md); their curvatures
             // still follow the stored ones closely

@@ -305,7 +305,9 @@ pub fn check_function<F: Differentiable + ?Sized>(f: &F, cfg: &CheckConfig) -> R
     let seed = cfg.seed ^ fxhash(&name);
     let inputs: Vec<Vec<f64>> = {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        (0..f.cases(cfg.cases)).map(|i| f.sample(&mut rng, i)).collect()
+        (0..f.cases(cfg.cases))
+            .map(|i| f.sample(&mut rng, i))
+            .collect()
     };
     let results: Vec<(Vec<f64>, CaseErrors)> = inputs
         .into_par_iter()
