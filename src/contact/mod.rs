@@ -13,8 +13,10 @@
 //! ρ = 0; the kernels still guard it and return [`ContactError::Overlap`] below [`RHO_MIN`] instead of a huge or
 //! non-finite number.
 
+pub mod checks;
 pub mod pair;
 
+pub use checks::diff_checks;
 pub use pair::{pair_energy_reference, PairKernel, PairVgh};
 
 use nalgebra::Vector3;

@@ -292,6 +292,7 @@ fn fxhash(s: &str) -> u64 {
 pub fn registry() -> Vec<Box<dyn Check>> {
     let mut checks: Vec<Box<dyn Check>> = Vec::new();
     checks.extend(crate::material::diff_checks());
+    checks.extend(crate::contact::diff_checks());
     checks
 }
 
