@@ -13,9 +13,14 @@
 //! ρ = 0; the kernels still guard it and return [`ContactError::Overlap`] below [`RHO_MIN`] instead of a huge or
 //! non-finite number.
 
+pub mod broad;
 pub mod checks;
 pub mod pair;
 
+pub use broad::{
+    brute_force_candidates, tile_segments, BroadPhase, CandidatePair, Segment, SegmentTopology,
+    TileImage, TileImages,
+};
 pub use checks::diff_checks;
 pub use pair::{pair_energy_reference, PairKernel, PairVgh};
 
