@@ -3,6 +3,8 @@
 //! order of the eigenpairs, ψ as the sum of its parts, finite values and derivatives at umbilic points and for
 //! |II| up to 1e4.
 
+mod contact;
+
 use hylc::material::hermite::{Hermite1D, Hermite2D};
 use hylc::material::synthetic::default_material;
 use hylc::material::Material;
