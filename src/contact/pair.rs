@@ -12,6 +12,9 @@
 //! ∇_d = β d,  ∇²_d = α d dᵀ + β I,  β = W g'(u)/(2r²),  α = W g''(u)/(4r⁴),
 //!
 //! and the term adds c_k β d to the gradient of point k and c_k c_l (α d dᵀ + β I) to the Hessian block (k, l).
+//! The accumulation factors the weights: for each node p the sums Σ_q M and Σ_q s_q M (M = α d dᵀ + β I) give
+//! the blocks that involve segment a, while the blocks of segment b are accumulated per term (35 multiply-adds
+//! per active term instead of 70 for the ten blocks separately).
 //! Terms with u ≥ 1 are exactly zero and skipped; when the segment–segment distance is at least 2r every term is
 //! zero and the kernels return zeros without visiting the quadrature pairs.
 
@@ -20,19 +23,12 @@ use crate::diff::Real;
 use crate::rod::YarnMaterial;
 use nalgebra::{SMatrix, SVector, Vector3};
 
-/// The 10 blocks (k ≤ l) of the symmetric 4×4 block Hessian, in the order of the accumulators.
-const BLOCKS: [(usize, usize); 10] = [
-    (0, 0),
-    (0, 1),
-    (0, 2),
-    (0, 3),
-    (1, 1),
-    (1, 2),
-    (1, 3),
-    (2, 2),
-    (2, 3),
-    (3, 3),
-];
+/// Index into the block accumulators of block (k, l) of the symmetric 4×4 block Hessian: the ten blocks k ≤ l
+/// in the order (0,0), (0,1), (0,2), (0,3), (1,1), (1,2), (1,3), (2,2), (2,3), (3,3).
+const BLOCK_OF: [[usize; 4]; 4] = [[0, 1, 2, 3], [1, 4, 5, 6], [2, 5, 7, 8], [3, 6, 8, 9]];
+
+/// Index of entry (i, j) of a symmetric 3×3 block stored as (xx, xy, xz, yy, yz, zz).
+const SYM_OF: [[usize; 3]; 3] = [[0, 1, 2], [1, 3, 4], [2, 4, 5]];
 
 /// Relative safety factor on (2r)² in the early reject: the computed segment distance may exceed the true one by
 /// round-off (most for nearly parallel segments), so the reject only fires when the squared distance is at least
@@ -175,13 +171,18 @@ impl PairKernel {
         let ea = x[1] - x[0];
         let eb = x[3] - x[2];
         let mut value = 0.0;
-        // gradient of d per point before the c_k factors is accumulated per point directly
+        // gradients of the four points
         let mut grad = [Vector3::<f64>::zeros(); 4];
-        // Hessian blocks (k ≤ l): symmetric 3×3 part α d dᵀ (xx, xy, xz, yy, yz, zz) and the β I part
-        let mut sym = [[0.0f64; 6]; 10];
-        let mut diag = [0.0f64; 10];
+        // Hessian blocks (k ≤ l, order of BLOCK_OF), each α d dᵀ + β I summed with weights c_k c_l, stored as
+        // (xx, xy, xz, yy, yz, zz, β)
+        let mut blk = [[0.0f64; 7]; 10];
         for p in 0..s.len() {
             let xa = x[0] + ea * s[p];
+            // over q: Σ M and Σ s_q M for the blocks that involve segment a, Σ β d for its gradient
+            let mut m_sum = [0.0f64; 7];
+            let mut m_sum_t = [0.0f64; 7];
+            let mut g_sum = Vector3::<f64>::zeros();
+            let mut active = false;
             for q in 0..s.len() {
                 let d = xa - (x[2] + eb * s[q]);
                 let u = d.norm_squared() * inv4r2;
@@ -198,6 +199,7 @@ impl PairKernel {
                         q,
                     });
                 }
+                active = true;
                 let wt = w[p] * w[q];
                 let iu = 1.0 / u;
                 let om = 1.0 - u;
@@ -205,11 +207,6 @@ impl PairKernel {
                 // β and α per unit k_c l̄_a l̄_b
                 let beta = wt * (1.0 - iu * iu) / (2.0 * r2);
                 let alpha = wt * iu * iu * iu / (2.0 * r2 * r2);
-                let c = [1.0 - s[p], s[p], -(1.0 - s[q]), -s[q]];
-                let gd = d * beta;
-                for k in 0..4 {
-                    grad[k] += gd * c[k];
-                }
                 let m = [
                     alpha * d.x * d.x,
                     alpha * d.x * d.y,
@@ -217,40 +214,69 @@ impl PairKernel {
                     alpha * d.y * d.y,
                     alpha * d.y * d.z,
                     alpha * d.z * d.z,
+                    beta,
                 ];
-                for (b, &(k, l)) in BLOCKS.iter().enumerate() {
-                    let ckl = c[k] * c[l];
-                    for e in 0..6 {
-                        sym[b][e] += ckl * m[e];
-                    }
-                    diag[b] += ckl * beta;
+                // segment b: c = (−(1 − t), −t)
+                let t = s[q];
+                let omt = 1.0 - t;
+                let (w22, w23, w33) = (omt * omt, omt * t, t * t);
+                for e in 0..7 {
+                    m_sum[e] += m[e];
+                    m_sum_t[e] += t * m[e];
+                    blk[7][e] += w22 * m[e];
+                    blk[8][e] += w23 * m[e];
+                    blk[9][e] += w33 * m[e];
                 }
+                let gd = d * beta;
+                g_sum += gd;
+                grad[2] -= gd * omt;
+                grad[3] -= gd * t;
+            }
+            if !active {
+                continue;
+            }
+            // segment a: c = (1 − s, s); mixed blocks use Σ_q c_2 M = Σ_q s_q M − Σ_q M and Σ_q c_3 M = −Σ_q s_q M
+            let (ca0, ca1) = (1.0 - s[p], s[p]);
+            grad[0] += g_sum * ca0;
+            grad[1] += g_sum * ca1;
+            let (w00, w01, w11) = (ca0 * ca0, ca0 * ca1, ca1 * ca1);
+            for e in 0..7 {
+                let (ms, mt) = (m_sum[e], m_sum_t[e]);
+                let (m2, m3) = (mt - ms, -mt);
+                blk[0][e] += w00 * ms;
+                blk[1][e] += w01 * ms;
+                blk[4][e] += w11 * ms;
+                blk[2][e] += ca0 * m2;
+                blk[3][e] += ca0 * m3;
+                blk[5][e] += ca1 * m2;
+                blk[6][e] += ca1 * m3;
             }
         }
         let scale = self.stiffness * rest_a * rest_b;
-        let mut out = PairVgh::zero();
-        out.value = scale * value;
+        let mut gradient = [0.0f64; 12];
         for k in 0..4 {
             for i in 0..3 {
-                out.gradient[3 * k + i] = scale * grad[k][i];
+                gradient[3 * k + i] = scale * grad[k][i];
             }
         }
-        for (b, &(k, l)) in BLOCKS.iter().enumerate() {
-            let m = &sym[b];
-            let dg = diag[b];
-            let block = [
-                [m[0] + dg, m[1], m[2]],
-                [m[1], m[3] + dg, m[4]],
-                [m[2], m[4], m[5] + dg],
-            ];
-            for i in 0..3 {
-                for j in 0..3 {
-                    let v = scale * block[i][j];
-                    out.hessian[(3 * k + i, 3 * l + j)] = v;
-                    out.hessian[(3 * l + j, 3 * k + i)] = v;
-                }
-            }
-        }
+        // each block with its diagonal folded in, scaled: (xx, xy, xz, yy, yz, zz)
+        let full: [[f64; 6]; 10] = std::array::from_fn(|b| {
+            let m = &blk[b];
+            [
+                scale * (m[0] + m[6]),
+                scale * m[1],
+                scale * m[2],
+                scale * (m[3] + m[6]),
+                scale * m[4],
+                scale * (m[5] + m[6]),
+            ]
+        });
+        // every entry written once, straight into the output
+        let out = PairVgh {
+            value: scale * value,
+            gradient: SVector::from(gradient),
+            hessian: SMatrix::from_fn(|i, j| full[BLOCK_OF[i / 3][j / 3]][SYM_OF[i % 3][j % 3]]),
+        };
         Ok(out)
     }
 }
