@@ -37,6 +37,10 @@
 //! is not updated: call [`BroadPhase::candidates`] again. For new tile transforms (another macro strain) build a
 //! new broad phase. Refitting keeps the tree topology; after large rearrangements a fresh [`BroadPhase::new`] gives
 //! a tighter tree.
+//!
+//! Only the images passed in are searched: the home and its 8 neighbours suffice as long as no segment comes
+//! within 2r + margin of a copy two or more tiles away (periods larger than the tile's extent across them plus
+//! 2r + margin, which holds for every realistic pattern and strain); pass more images otherwise.
 
 use super::{segment_distance_squared, ContactError};
 use crate::pattern::{Edge, Pattern};
@@ -442,8 +446,7 @@ impl BroadPhase {
         Ok(())
     }
 
-    /// The canonical candidate pairs at the current positions, sorted (image, then b, then a… see
-    /// [`CandidatePair`]'s ordering: by a, then b, then image).
+    /// The canonical candidate pairs at the current positions, sorted by (a, b, image).
     pub fn candidates(&self) -> Vec<CandidatePair> {
         let inflate = self.inflation();
         let mut out = Vec::new();
