@@ -3,6 +3,7 @@
 //! order of the eigenpairs, ψ as the sum of its parts, finite values and derivatives at umbilic points and for
 //! |II| up to 1e4.
 
+mod contact;
 mod rod;
 
 use hylc::material::hermite::{Hermite1D, Hermite2D};

@@ -4,10 +4,12 @@
 //! spline material ψ(z) ([`material`]) come first; the yarn model, micro solver, fitting and cloth solver build on
 //! them.
 
+pub mod contact;
 pub mod diff;
 pub mod material;
 pub mod pattern;
 pub mod rod;
+pub mod tile;
 
 use std::path::PathBuf;
 

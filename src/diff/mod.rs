@@ -331,6 +331,8 @@ pub fn registry() -> Vec<Box<dyn Check>> {
     let mut checks: Vec<Box<dyn Check>> = Vec::new();
     checks.extend(crate::material::diff_checks());
     checks.extend(crate::rod::diff_checks());
+    checks.extend(crate::contact::diff_checks());
+    checks.extend(crate::tile::diff_checks());
     checks
 }
 

@@ -892,3 +892,12 @@ pub fn to_obj(p: &Pattern) -> String {
     }
     out
 }
+
+/// The small generated patterns the whole-tile derivative harness runs on (`06-verification.md`: "the total micro
+/// energy … on a small pattern"): the default plain weave (40 vertices, 160 dofs, yarns touching at crossings).
+pub fn harness_patterns() -> Vec<(&'static str, Pattern)> {
+    vec![(
+        "plain",
+        weave(&WeaveParams::plain()).expect("the default plain weave is valid"),
+    )]
+}

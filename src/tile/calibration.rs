@@ -1,0 +1,217 @@
+//! Calibration of the yarn parameters against patterns that should be static equilibria
+//! (`06-verification.md` item b, `02-yarn-model.md` "What the original reference patterns tell").
+//!
+//! At a pattern's stored state the energy gradient is linear in the stiffness parameters:
+//!
+//! ∇E = Y a_s + (γY) a_b + (γG) a_t + k_c a_c,
+//!
+//! with a_s, a_b, a_t, a_c the gradients of the stretching, bending, twisting and contact terms per unit parameter
+//! (the contact term for a given quadrature order, exclusion and radius). Angles enter as r·θ (the unit scaling of
+//! `03-homogenization.md`), so every entry is a force. The overall scale is free (Y = 1e6 Pa fixes it); the best
+//! (γY, γG, k_c) ≥ 0 for one pattern or a set of patterns is a small non-negative linear least-squares problem.
+//!
+//! Residual reported: ‖∇E‖ / ‖∇E_rods‖ with ‖∇E_rods‖ = (‖Y a_s‖² + ‖γY a_b‖² + ‖γG a_t‖²)^½, the size of the rod
+//! forces that have to cancel (a pattern balanced by its rods alone still has large individual rod forces).
+
+use super::{Terms, Tile, Want};
+use crate::contact::ContactError;
+use crate::pattern::Pattern;
+use crate::rod::{RodState, YarnMaterial};
+use nalgebra::{DMatrix, DVector};
+
+/// The contact model variant of a calibration: quadrature order, exclusion along the yarn, contact radius factor
+/// (contact distance 2·factor·r).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactForm {
+    pub quadrature: usize,
+    pub exclusion: usize,
+    pub radius_factor: f64,
+}
+
+impl Default for ContactForm {
+    fn default() -> Self {
+        ContactForm {
+            quadrature: 4,
+            exclusion: 3,
+            radius_factor: 1.0,
+        }
+    }
+}
+
+/// Gradients of each term per unit parameter at a pattern's stored state (θ rows multiplied by 1/r, i.e. with
+/// respect to r·θ).
+#[derive(Clone, Debug)]
+pub struct GradientParts {
+    pub stretch: DVector<f64>,
+    pub bend: DVector<f64>,
+    pub twist: DVector<f64>,
+    pub contact: DVector<f64>,
+    /// Number of position rows (the rest are angle rows).
+    pub n_positions: usize,
+    /// Number of contact pairs with a non-zero energy.
+    pub active_pairs: usize,
+}
+
+/// The per-unit gradients of `pattern` at its stored state.
+pub fn gradient_parts(
+    pattern: &Pattern,
+    form: &ContactForm,
+) -> Result<GradientParts, ContactError> {
+    let unit = YarnMaterial {
+        young: 1.0,
+        shear: 1.0,
+        bend_twist_factor: 1.0,
+        radius: pattern.radius,
+        density: 0.0,
+        contact_stiffness: 1.0,
+        contact_quadrature: form.quadrature,
+        contact_exclusion: form.exclusion,
+    };
+    let state = RodState::from_pattern(pattern);
+    let mut tile = Tile::new(pattern, &unit);
+    tile.contact_radius = pattern.radius * form.radius_factor;
+    tile.update_contacts(&state.positions, 0.5 * pattern.radius)?;
+    let y = Tile::dofs_of(&state);
+    let n = pattern.len();
+    let part = |terms: Terms| -> Result<(DVector<f64>, f64), ContactError> {
+        let r = tile.evaluate(&state, &y, Want::Gradient, &terms)?;
+        let mut g = r.gradient.expect("gradient requested");
+        for v in g.iter_mut().skip(3 * n) {
+            *v /= pattern.radius;
+        }
+        Ok((g, r.parts.total()))
+    };
+    let only = |s, b, t, c| Terms {
+        stretch: s,
+        bend: b,
+        twist: t,
+        contact: c,
+    };
+    let (stretch, _) = part(only(1.0, 0.0, 0.0, 0.0))?;
+    let (bend, _) = part(only(0.0, 1.0, 0.0, 0.0))?;
+    let (twist, _) = part(only(0.0, 0.0, 1.0, 0.0))?;
+    let (contact, _) = part(only(0.0, 0.0, 0.0, 1.0))?;
+    let active_pairs = tile.active_contact_pairs(&y)?;
+    Ok(GradientParts {
+        stretch,
+        bend,
+        twist,
+        contact,
+        n_positions: 3 * n,
+        active_pairs,
+    })
+}
+
+/// Stiffness parameters of a calibration (Y fixed by the caller).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stiffness {
+    pub young: f64,
+    /// γY
+    pub bend: f64,
+    /// γG
+    pub twist: f64,
+    /// k_c
+    pub contact: f64,
+}
+
+impl Stiffness {
+    /// From the physical parameters.
+    pub fn from_material(m: &YarnMaterial) -> Self {
+        Stiffness {
+            young: m.young,
+            bend: m.bend_twist_factor * m.young,
+            twist: m.bend_twist_factor * m.shear,
+            contact: m.contact_stiffness,
+        }
+    }
+    pub fn gamma(&self) -> f64 {
+        self.bend / self.young
+    }
+    pub fn shear_over_young(&self) -> f64 {
+        self.twist / self.bend
+    }
+}
+
+/// Relative residual ‖∇E‖ / ‖∇E_rods‖ of one pattern for given stiffnesses (see the module documentation).
+pub fn residual(parts: &GradientParts, k: &Stiffness) -> f64 {
+    let s = &parts.stretch * k.young;
+    let b = &parts.bend * k.bend;
+    let t = &parts.twist * k.twist;
+    let c = &parts.contact * k.contact;
+    let total = &s + &b + &t + &c;
+    total.norm() / (s.norm_squared() + b.norm_squared() + t.norm_squared()).sqrt()
+}
+
+/// Residual of the angle rows only (twisting against bending; stretching and contact do not act on θ).
+pub fn angle_residual(parts: &GradientParts, k: &Stiffness) -> f64 {
+    let n = parts.n_positions;
+    let b = parts.bend.rows(n, parts.bend.len() - n) * k.bend;
+    let t = parts.twist.rows(n, parts.twist.len() - n) * k.twist;
+    (&b + &t).norm() / (b.norm_squared() + t.norm_squared()).sqrt()
+}
+
+/// G/Y from the angle rows alone: the ratio γG/γY minimising ‖γY a_b^θ + γG a_t^θ‖.
+pub fn shear_ratio_from_angles(parts: &GradientParts) -> f64 {
+    let n = parts.n_positions;
+    let b = parts.bend.rows(n, parts.bend.len() - n);
+    let t = parts.twist.rows(n, parts.twist.len() - n);
+    -b.dot(&t) / t.norm_squared()
+}
+
+/// The best non-negative (γY, γG, k_c) for a set of patterns at fixed Y (sum of squared residual forces, each
+/// pattern's rows scaled by its own rod-force size at the default parameters so patterns count equally).
+/// `use_contact = false` fits the rod parameters with k_c = 0.
+pub fn fit(parts: &[&GradientParts], young: f64, use_contact: bool) -> Stiffness {
+    let ncol = if use_contact { 3 } else { 2 };
+    let mut ata = DMatrix::<f64>::zeros(ncol, ncol);
+    let mut atb = DVector::<f64>::zeros(ncol);
+    let default = Stiffness::from_material(&YarnMaterial::default());
+    for p in parts {
+        let w = {
+            let s = p.stretch.norm_squared() * default.young.powi(2)
+                + p.bend.norm_squared() * default.bend.powi(2)
+                + p.twist.norm_squared() * default.twist.powi(2);
+            1.0 / s
+        };
+        let cols: Vec<&DVector<f64>> = if use_contact {
+            vec![&p.bend, &p.twist, &p.contact]
+        } else {
+            vec![&p.bend, &p.twist]
+        };
+        for i in 0..ncol {
+            atb[i] -= w * cols[i].dot(&p.stretch) * young;
+            for j in 0..ncol {
+                ata[(i, j)] += w * cols[i].dot(cols[j]);
+            }
+        }
+    }
+    // non-negative least squares by enumerating the active sets (at most 3 unknowns)
+    let mut best: Option<(f64, DVector<f64>)> = None;
+    for mask in 1u32..(1 << ncol) {
+        let idx: Vec<usize> = (0..ncol).filter(|i| mask & (1 << i) != 0).collect();
+        let a = DMatrix::from_fn(idx.len(), idx.len(), |i, j| ata[(idx[i], idx[j])]);
+        let b = DVector::from_fn(idx.len(), |i, _| atb[idx[i]]);
+        let Some(sol) = a.lu().solve(&b) else {
+            continue;
+        };
+        if sol.iter().any(|&v| v < 0.0) {
+            continue;
+        }
+        let mut x = DVector::zeros(ncol);
+        for (k, &i) in idx.iter().enumerate() {
+            x[i] = sol[k];
+        }
+        // objective up to a constant: xᵀAx − 2bᵀx
+        let obj = (x.transpose() * &ata * &x)[0] - 2.0 * atb.dot(&x);
+        if best.as_ref().is_none_or(|(o, _)| obj < *o) {
+            best = Some((obj, x));
+        }
+    }
+    let x = best.map(|b| b.1).unwrap_or_else(|| DVector::zeros(ncol));
+    Stiffness {
+        young,
+        bend: x[0],
+        twist: x[1],
+        contact: if use_contact { x[2] } else { 0.0 },
+    }
+}

@@ -1,0 +1,132 @@
+//! Contact part of the tile energy: the Kaldor pair kernel (`crate::contact`) summed over the tile's contact pairs
+//! (`02-yarn-model.md`, "Yarn-yarn contact").
+
+use super::{Tile, Want};
+use crate::contact::{
+    tile_segments, BroadPhase, ContactError, PairKernel, SegmentTopology, TileImages,
+};
+use nalgebra::{DVector, Vector3};
+use rayon::prelude::*;
+
+/// Segment `a` (the outgoing edge of vertex `a` in the home tile) against segment `b` in the periodic image at
+/// offset `image`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ContactPair {
+    pub a: usize,
+    pub b: usize,
+    pub image: [i32; 2],
+}
+
+impl ContactPair {
+    /// (vertex, offset) of the four points (x_a0, x_a1, x_b0, x_b1).
+    pub fn points(&self, tile: &Tile) -> [(usize, [i32; 2]); 4] {
+        let ea = &tile.pattern.edges[self.a];
+        let eb = &tile.pattern.edges[self.b];
+        let o = self.image;
+        [
+            (self.a, [0, 0]),
+            (ea.end, ea.offset),
+            (self.b, o),
+            (eb.end, [o[0] + eb.offset[0], o[1] + eb.offset[1]]),
+        ]
+    }
+}
+
+/// Sum the pair energies (weight × k_c) into the gradient and Hessian triplets; returns the contact energy.
+pub(super) fn assemble(
+    tile: &Tile,
+    y: &[f64],
+    want: Want,
+    weight: f64,
+    grad: &mut Option<DVector<f64>>,
+    trip: &mut Option<Vec<(usize, usize, f64)>>,
+) -> Result<f64, ContactError> {
+    let m = &tile.material;
+    let kernel = PairKernel::new(
+        m.contact_stiffness * weight,
+        tile.contact_radius,
+        m.contact_quadrature,
+    )?;
+    let locals: Vec<Result<super::Local<12>, ContactError>> = tile
+        .contacts
+        .par_iter()
+        .map(|pair| {
+            let pts = pair.points(tile);
+            let x: [Vector3<f64>; 4] = pts.map(|(v, o)| tile.position(y, v, o));
+            let la = tile.pattern.edges[pair.a].rest_length;
+            let lb = tile.pattern.edges[pair.b].rest_length;
+            if want == Want::Value {
+                Ok(super::Local {
+                    value: kernel.value(&x, la, lb)?,
+                    g: Default::default(),
+                    h: Default::default(),
+                })
+            } else {
+                let r = kernel.value_gradient_hessian(&x, la, lb)?;
+                Ok(super::Local {
+                    value: r.value,
+                    g: r.gradient,
+                    h: r.hessian,
+                })
+            }
+        })
+        .collect();
+    let mut total = 0.0;
+    for (pair, l) in tile.contacts.iter().zip(locals) {
+        let l = l?;
+        if l.value == 0.0 && want == Want::Value {
+            continue;
+        }
+        total += l.value;
+        if want != Want::Value && l.g.iter().any(|&v| v != 0.0) {
+            tile.scatter_positions(&pair.points(tile), &[], &l, grad, trip);
+        }
+    }
+    Ok(total)
+}
+
+impl<'a> Tile<'a> {
+    /// Find the contact pairs of the tile at `positions` with the BVH broad phase (`crate::contact::broad`): every
+    /// pair of segments closer than 2r + `margin` that is not excluded along its yarn, each physical pair once.
+    /// The list stays complete while no vertex moves by more than `margin / 2`.
+    pub fn update_contacts(
+        &mut self,
+        positions: &[Vector3<f64>],
+        margin: f64,
+    ) -> Result<(), ContactError> {
+        let images = TileImages::flat(self.pattern.periods);
+        let segments = tile_segments(self.pattern, positions, &images)?;
+        let broad = BroadPhase::new(
+            &segments,
+            SegmentTopology::from_pattern(self.pattern),
+            images.clone(),
+            self.contact_radius,
+            margin,
+            self.material.contact_exclusion,
+        )?;
+        self.contacts = broad
+            .candidates()
+            .into_iter()
+            .map(|c| ContactPair {
+                a: c.a,
+                b: c.b,
+                image: images.get(c.image).offset,
+            })
+            .collect();
+        Ok(())
+    }
+
+    /// Number of contact pairs with a non-zero energy at dofs `y`.
+    pub fn active_contact_pairs(&self, y: &[f64]) -> Result<usize, ContactError> {
+        let m = &self.material;
+        let kernel = PairKernel::new(1.0, self.contact_radius, m.contact_quadrature)?;
+        let mut count = 0;
+        for pair in &self.contacts {
+            let x = pair.points(self).map(|(v, o)| self.position(y, v, o));
+            if kernel.value(&x, 1.0, 1.0)? > 0.0 {
+                count += 1;
+            }
+        }
+        Ok(count)
+    }
+}
