@@ -1,5 +1,8 @@
 //! The `hylc` command line (`../shared/design/01-architecture.md`, "Command line").
 
+#[path = "hylc/calibrate.rs"]
+mod calibrate;
+
 use clap::{Parser, Subcommand};
 use hylc::diff::{format_table, run_all, CheckConfig};
 use hylc::material::synthetic::default_material;
@@ -87,6 +90,28 @@ enum Command {
         /// write the centre lines as an OBJ polyline file (for Blender or ParaView)
         #[arg(long)]
         obj: Option<PathBuf>,
+        /// write the pattern as a `.pyp` file
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Calibrate the yarn parameters so that the original reference patterns are static equilibria: per contact
+    /// form, the residual force at the defaults, the best parameters per pattern and the joint fit.
+    Calibrate {
+        /// folder with the original `.pyp` files (default: ../shared/data/hylc2020/patterns)
+        #[arg(long)]
+        dir: Option<PathBuf>,
+        /// contact quadrature orders to try (comma-separated)
+        #[arg(long, default_value = "4")]
+        quadrature: String,
+        /// contact exclusions (neighbour segments on each side) to try
+        #[arg(long, default_value = "3")]
+        exclusion: String,
+        /// contact radius factors to try (contact distance 2 x factor x r)
+        #[arg(long, default_value = "1")]
+        radius_factor: String,
+        /// write all rows as JSON
+        #[arg(long)]
+        json: Option<PathBuf>,
     },
 }
 
@@ -113,7 +138,28 @@ fn main() -> ExitCode {
             step,
             vertices_per_radius,
             obj,
-        } => generate_cmd(&kind, n, step, vertices_per_radius, obj.as_deref()),
+            out,
+        } => generate_cmd(
+            &kind,
+            n,
+            step,
+            vertices_per_radius,
+            obj.as_deref(),
+            out.as_deref(),
+        ),
+        Command::Calibrate {
+            dir,
+            quadrature,
+            exclusion,
+            radius_factor,
+            json,
+        } => calibrate::run(
+            dir.as_deref(),
+            &quadrature,
+            &exclusion,
+            &radius_factor,
+            json.as_deref(),
+        ),
     };
     match result {
         Ok(code) => code,
@@ -176,6 +222,7 @@ fn generate_cmd(
     step: Option<usize>,
     vertices_per_radius: f64,
     obj: Option<&Path>,
+    out: Option<&Path>,
 ) -> Result<ExitCode, String> {
     let weave_params = match kind {
         "plain" => Some(WeaveParams::plain()),
@@ -245,6 +292,10 @@ fn generate_cmd(
     if let Some(path) = obj {
         std::fs::write(path, to_obj(&pattern))
             .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    if let Some(path) = out {
+        pattern.save_pyp(path).map_err(|e| e.to_string())?;
         println!("wrote {}", path.display());
     }
     Ok(ExitCode::SUCCESS)

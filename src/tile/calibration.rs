@@ -215,3 +215,133 @@ pub fn fit(parts: &[&GradientParts], young: f64, use_contact: bool) -> Stiffness
         contact: if use_contact { x[2] } else { 0.0 },
     }
 }
+
+/// One row of the calibration table: a pattern under one contact form.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CalibrationRow {
+    pub pattern: String,
+    pub quadrature: usize,
+    pub exclusion: usize,
+    pub radius_factor: f64,
+    /// Contact pairs with non-zero energy at the stored state.
+    pub active_pairs: usize,
+    /// G/Y from the angle rows alone.
+    pub shear_over_young_from_angles: f64,
+    /// ‖∇E‖/‖∇E_rods‖ at the given (default) parameters.
+    pub residual_default: f64,
+    /// Residual with the joint fit over the calibration set.
+    pub residual_joint: f64,
+    /// The best parameters for this pattern alone (Y fixed) and the residual they reach.
+    pub own_gamma: f64,
+    pub own_shear_over_young: f64,
+    pub own_contact_stiffness: f64,
+    pub residual_own: f64,
+    /// The best residual without contact (k_c = 0).
+    pub residual_own_no_contact: f64,
+}
+
+/// The joint calibration over a set of patterns and the per-pattern rows.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Calibration {
+    pub quadrature: usize,
+    pub exclusion: usize,
+    pub radius_factor: f64,
+    pub young: f64,
+    pub gamma: f64,
+    pub shear_over_young: f64,
+    pub contact_stiffness: f64,
+    pub rows: Vec<CalibrationRow>,
+}
+
+/// Calibrate on `fit_set` (pattern names) for one contact form and report every pattern of `patterns`, with the
+/// default parameters of `material` as the "default" column.
+pub fn calibrate(
+    patterns: &[(String, Pattern)],
+    fit_set: &[&str],
+    form: &ContactForm,
+    material: &YarnMaterial,
+) -> Result<Calibration, ContactError> {
+    let parts: Vec<GradientParts> = patterns
+        .iter()
+        .map(|(_, p)| gradient_parts(p, form))
+        .collect::<Result<_, _>>()?;
+    let chosen: Vec<&GradientParts> = patterns
+        .iter()
+        .zip(&parts)
+        .filter(|((name, _), _)| fit_set.contains(&name.as_str()))
+        .map(|(_, g)| g)
+        .collect();
+    let young = material.young;
+    let joint = fit(&chosen, young, true);
+    let default = Stiffness::from_material(material);
+    let rows = patterns
+        .iter()
+        .zip(&parts)
+        .map(|((name, _), g)| {
+            let own = fit(&[g], young, true);
+            let own_nc = fit(&[g], young, false);
+            CalibrationRow {
+                pattern: name.clone(),
+                quadrature: form.quadrature,
+                exclusion: form.exclusion,
+                radius_factor: form.radius_factor,
+                active_pairs: g.active_pairs,
+                shear_over_young_from_angles: shear_ratio_from_angles(g),
+                residual_default: residual(g, &default),
+                residual_joint: residual(g, &joint),
+                own_gamma: own.gamma(),
+                own_shear_over_young: own.shear_over_young(),
+                own_contact_stiffness: own.contact,
+                residual_own: residual(g, &own),
+                residual_own_no_contact: residual(g, &own_nc),
+            }
+        })
+        .collect();
+    Ok(Calibration {
+        quadrature: form.quadrature,
+        exclusion: form.exclusion,
+        radius_factor: form.radius_factor,
+        young,
+        gamma: joint.gamma(),
+        shear_over_young: joint.shear_over_young(),
+        contact_stiffness: joint.contact,
+        rows,
+    })
+}
+
+/// The periods at which the pattern's stored state is closest to an equilibrium for stiffnesses `k` (the in-plane
+/// minimum of Algorithm C1 step 3, restricted to the periods): Gauss–Newton on p ↦ ∇E(p) with a central
+/// finite-difference Jacobian (relative step 1e-7), starting from the pattern's periods. Used to correct a
+/// pattern whose stored periods are inconsistent with its periodic edges (basket.pyp).
+pub fn equilibrium_periods(
+    pattern: &Pattern,
+    form: &ContactForm,
+    k: &Stiffness,
+) -> Result<[f64; 2], ContactError> {
+    let force = |periods: [f64; 2]| -> Result<DVector<f64>, ContactError> {
+        let mut p = pattern.clone();
+        p.periods = periods;
+        let g = gradient_parts(&p, form)?;
+        Ok(&g.stretch * k.young + &g.bend * k.bend + &g.twist * k.twist + &g.contact * k.contact)
+    };
+    let mut per = pattern.periods;
+    for _ in 0..8 {
+        let f0 = force(per)?;
+        let mut jac = DMatrix::<f64>::zeros(f0.len(), 2);
+        for c in 0..2 {
+            let h = 1e-7 * per[c];
+            let (mut a, mut b) = (per, per);
+            a[c] += h;
+            b[c] -= h;
+            jac.set_column(c, &((force(a)? - force(b)?) / (2.0 * h)));
+        }
+        let jtj = jac.transpose() * &jac;
+        let step = jtj.lu().solve(&(-(jac.transpose() * &f0)));
+        let Some(step) = step else { break };
+        per = [per[0] + step[0], per[1] + step[1]];
+        if step.norm() < 1e-12 * (per[0] + per[1]) {
+            break;
+        }
+    }
+    Ok(per)
+}

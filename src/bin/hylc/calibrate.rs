@@ -1,0 +1,145 @@
+//! `hylc calibrate`: the yarn-parameter calibration against the original reference patterns
+//! (`06-verification.md` item b; `hylc::tile::calibration`).
+
+use hylc::pattern::Pattern;
+use hylc::rod::YarnMaterial;
+use hylc::tile::calibration::{
+    calibrate, equilibrium_periods, Calibration, ContactForm, Stiffness,
+};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// The original patterns, the set the joint fit uses, and the file names.
+const ORIGINALS: [&str; 5] = [
+    "basket",
+    "satin",
+    "slip_stitch_honeycomb",
+    "stockinette",
+    "cartridge_belt_rib",
+];
+const FIT_SET: [&str; 3] = ["basket", "satin", "slip_stitch_honeycomb"];
+
+fn parse_list<T: std::str::FromStr>(text: &str, what: &str) -> Result<Vec<T>, String> {
+    text.split(',')
+        .map(|s| {
+            s.trim()
+                .parse()
+                .map_err(|_| format!("--{what}: cannot parse {s:?} in {text:?}"))
+        })
+        .collect()
+}
+
+pub fn run(
+    dir: Option<&Path>,
+    quadrature: &str,
+    exclusion: &str,
+    radius_factor: &str,
+    json: Option<&Path>,
+) -> Result<ExitCode, String> {
+    let dir: PathBuf = match dir {
+        Some(d) => d.to_path_buf(),
+        None => hylc::shared_dir()
+            .map(|s| s.join("data/hylc2020/patterns"))
+            .ok_or("the original patterns were not found: pass --dir or set HYLC_SHARED")?,
+    };
+    let qs: Vec<usize> = parse_list(quadrature, "quadrature")?;
+    let xs: Vec<usize> = parse_list(exclusion, "exclusion")?;
+    let rs: Vec<f64> = parse_list(radius_factor, "radius-factor")?;
+    let material = YarnMaterial::default();
+    let mut patterns: Vec<(String, Pattern)> = Vec::new();
+    for name in ORIGINALS {
+        let path = dir.join(format!("{name}.pyp"));
+        let (mut p, warnings) = Pattern::load_pyp(&path).map_err(|e| e.to_string())?;
+        if !warnings.is_empty() {
+            if let Some(implied) = p.implied_periods() {
+                // the rest lengths imply the periods to ~1e-4; the equilibrium (zero macro stress) fixes them
+                let stored = p.periods;
+                p.periods = implied;
+                let eq = equilibrium_periods(
+                    &p,
+                    &ContactForm::default(),
+                    &Stiffness::from_material(&material),
+                )
+                .map_err(|e| format!("{name}: {e}"))?;
+                println!(
+                    "{name}: stored periods {:.7} x {:.7} m are inconsistent with the periodic edges; \
+                     the rest lengths imply {:.7} x {:.7} m; the equilibrium periods at the defaults are \
+                     {:.7} x {:.7} m ({:+.3} %, {:+.3} % from the stored ones): using those",
+                    stored[0],
+                    stored[1],
+                    implied[0],
+                    implied[1],
+                    eq[0],
+                    eq[1],
+                    100.0 * (eq[0] / stored[0] - 1.0),
+                    100.0 * (eq[1] / stored[1] - 1.0)
+                );
+                p.periods = eq;
+            }
+        }
+        patterns.push((name.to_string(), p));
+    }
+    println!(
+        "defaults: Y = {:.3e} Pa, G/Y = {}, gamma = {}, k_c = {} J/m^2; joint fit over {}",
+        material.young,
+        material.shear / material.young,
+        material.bend_twist_factor,
+        material.contact_stiffness,
+        FIT_SET.join(", ")
+    );
+    println!("residual = |grad E| / |grad E_rods| at the stored state (angles as r*theta)");
+    let mut all: Vec<Calibration> = Vec::new();
+    for &q in &qs {
+        for &x in &xs {
+            for &rf in &rs {
+                let form = ContactForm {
+                    quadrature: q,
+                    exclusion: x,
+                    radius_factor: rf,
+                };
+                let c = calibrate(&patterns, &FIT_SET, &form, &material)
+                    .map_err(|e| format!("calibration Q={q} exclusion={x}: {e}"))?;
+                println!(
+                    "\nQ = {q}, exclusion = {x}, contact radius x{rf}: joint fit gamma = {:.4}, G/Y = {:.4}, k_c = {:.1} J/m^2",
+                    c.gamma, c.shear_over_young, c.contact_stiffness
+                );
+                println!(
+                    "{:<22} {:>6} {:>9} {:>9} {:>9} | {:>7} {:>7} {:>8} {:>9} {:>9}",
+                    "pattern",
+                    "pairs",
+                    "G/Y(th)",
+                    "res.def",
+                    "res.joint",
+                    "own γ",
+                    "own G/Y",
+                    "own k_c",
+                    "res.own",
+                    "no cont."
+                );
+                for r in &c.rows {
+                    println!(
+                        "{:<22} {:>6} {:>9.4} {:>9.4} {:>9.4} | {:>7.4} {:>7.4} {:>8.1} {:>9.4} {:>9.4}",
+                        r.pattern,
+                        r.active_pairs,
+                        r.shear_over_young_from_angles,
+                        r.residual_default,
+                        r.residual_joint,
+                        r.own_gamma,
+                        r.own_shear_over_young,
+                        r.own_contact_stiffness,
+                        r.residual_own,
+                        r.residual_own_no_contact
+                    );
+                }
+                all.push(c);
+            }
+        }
+    }
+    if let Some(path) = json {
+        let text = serde_json::to_string_pretty(&all).map_err(|e| e.to_string())?;
+        std::fs::write(path, text + "\n")
+            .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+        println!("\nwrote {}", path.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
