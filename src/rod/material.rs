@@ -2,7 +2,7 @@
 //! contact"): one struct that every yarn energy takes by reference.
 
 /// Parameters of the yarn model. Defaults are the calibrated values (see the README's calibration table):
-/// Y = 1e6 Pa, G/Y = 0.4, γ = 0.1, r = 1 mm, ρ = 120 kg/m³, Kaldor contact with k_c = 60 J/m², 4 Gauss–Legendre
+/// Y = 1e6 Pa, G/Y = 0.4, γ = 0.1, r = 1 mm, ρ = 120 kg/m³, Kaldor contact with k_c = 76 J/m², 4 Gauss–Legendre
 /// points per segment and 3 excluded neighbour segments on each side.
 #[derive(Clone, Debug, PartialEq)]
 pub struct YarnMaterial {
@@ -32,7 +32,7 @@ impl Default for YarnMaterial {
             bend_twist_factor: 0.1,
             radius: 1e-3,
             density: 120.0,
-            contact_stiffness: 60.0,
+            contact_stiffness: 76.0,
             contact_quadrature: 4,
             contact_exclusion: 3,
         }
