@@ -82,7 +82,17 @@ pub fn format_table(reports: &[Report]) -> String {
         "status"
     );
     for r in reports {
-        let input: Vec<String> = r.worst_input.iter().map(|v| format!("{v:.6e}")).collect();
+        // long inputs (a whole tile) are shortened to their first entries and their length
+        const SHOWN: usize = 32;
+        let mut input: Vec<String> = r
+            .worst_input
+            .iter()
+            .take(SHOWN)
+            .map(|v| format!("{v:.6e}"))
+            .collect();
+        if r.worst_input.len() > SHOWN {
+            input.push(format!("… ({} values)", r.worst_input.len()));
+        }
         s.push_str(&format!(
             "{:<34} {:>6} {:>9.2e} {:>9.2e} {:>9.2e} {:>9.2e} {:>9.2e} {:>6} {:>7.1e}  {:<6} [{}]\n",
             r.name,
