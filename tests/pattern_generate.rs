@@ -667,18 +667,7 @@ fn straight_wefts(ys: &[f64], m: usize, periods: [f64; 2]) -> Pattern {
             });
         }
     }
-    let n = positions.len();
-    Pattern {
-        periods,
-        radius: 1.0,
-        positions,
-        theta: vec![0.0; n],
-        edges,
-        rest_curvature: vec![[0.0; 2]; n],
-        rest_twist: vec![0.0; n],
-        ref_twist: vec![0.0; n],
-        edge_file_order: (0..n).collect(),
-    }
+    Pattern::from_geometry(periods, 1.0, positions, edges)
 }
 
 #[test]

@@ -16,14 +16,20 @@ fn plain() -> Pattern {
     weave(&WeaveParams::plain()).unwrap()
 }
 
-#[test]
-fn generated_weave_is_stress_free_in_the_rods_and_touches_at_crossings() {
-    let p = plain();
-    let state = RodState::from_pattern(&p);
-    let mut tile = Tile::new(&p, &YarnMaterial::default());
+/// The pattern's own state, a tile with its contact pairs, and the state's dofs.
+fn tile_of(p: &Pattern) -> (RodState, Tile<'_>, Vec<f64>) {
+    let state = RodState::from_pattern(p);
+    let mut tile = Tile::new(p, &YarnMaterial::default());
     tile.update_contacts(&state.positions, 0.5 * p.radius)
         .unwrap();
     let y = Tile::dofs_of(&state);
+    (state, tile, y)
+}
+
+#[test]
+fn generated_weave_is_stress_free_in_the_rods_and_touches_at_crossings() {
+    let p = plain();
+    let (state, tile, y) = tile_of(&p);
     let e = tile
         .evaluate(&state, &y, Want::Gradient, &Terms::ALL)
         .unwrap();
@@ -42,11 +48,7 @@ fn generated_weave_is_stress_free_in_the_rods_and_touches_at_crossings() {
 #[test]
 fn tile_gradient_and_hessian_vanish_on_translations() {
     let p = plain();
-    let state = RodState::from_pattern(&p);
-    let mut tile = Tile::new(&p, &YarnMaterial::default());
-    tile.update_contacts(&state.positions, 0.5 * p.radius)
-        .unwrap();
-    let mut y = Tile::dofs_of(&state);
+    let (state, tile, mut y) = tile_of(&p);
     // a generic state near the stored one
     for (k, v) in y.iter_mut().enumerate() {
         *v += 1e-5 * ((k as f64) * 0.7).sin();
@@ -85,11 +87,7 @@ fn tile_gradient_and_hessian_vanish_on_translations() {
 #[test]
 fn tile_results_do_not_depend_on_the_number_of_threads() {
     let p = plain();
-    let state = RodState::from_pattern(&p);
-    let mut tile = Tile::new(&p, &YarnMaterial::default());
-    tile.update_contacts(&state.positions, 0.5 * p.radius)
-        .unwrap();
-    let y = Tile::dofs_of(&state);
+    let (state, tile, y) = tile_of(&p);
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()

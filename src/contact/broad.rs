@@ -562,17 +562,7 @@ pub fn synthetic_weave(k: usize, per_yarn: usize, radius: f64) -> Pattern {
         }
     }
     let n = positions.len();
-    let mut pat = Pattern {
-        periods: [p, p],
-        radius,
-        positions,
-        theta: vec![0.0; n],
-        edges,
-        rest_curvature: vec![[0.0; 2]; n],
-        rest_twist: vec![0.0; n],
-        ref_twist: vec![0.0; n],
-        edge_file_order: (0..n).collect(),
-    };
+    let mut pat = Pattern::from_geometry([p, p], radius, positions, edges);
     for i in 0..n {
         pat.edges[i].rest_length = pat.edge_vector(i).norm();
     }

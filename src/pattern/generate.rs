@@ -604,18 +604,8 @@ fn assemble(
         }
         ranges.push(base..base + m);
     }
-    let n = positions.len();
-    let mut p = Pattern {
-        periods,
-        radius,
-        positions,
-        theta: vec![0.0; n],
-        edges,
-        rest_curvature: vec![[0.0; 2]; n],
-        rest_twist: vec![0.0; n],
-        ref_twist: vec![0.0; n],
-        edge_file_order: (0..n).collect(),
-    };
+    let mut p = Pattern::from_geometry(periods, radius, positions, edges);
+    let n = p.len();
     // centre: length-weighted (Voronoi) mean of the positions at the origin
     let lengths: Vec<f64> = (0..n).map(|i| p.edge_vector(i).norm()).collect();
     let prev = p.prev();

@@ -55,6 +55,28 @@ pub struct Edge {
 }
 
 impl Pattern {
+    /// A pattern from its geometry: θ = 0, zero rest curvatures, rest twists and reference twists, edges listed in
+    /// vertex order (generators then set the rest values from the shape).
+    pub fn from_geometry(
+        periods: [f64; 2],
+        radius: f64,
+        positions: Vec<Vector3<f64>>,
+        edges: Vec<Edge>,
+    ) -> Self {
+        let n = positions.len();
+        Pattern {
+            periods,
+            radius,
+            positions,
+            theta: vec![0.0; n],
+            edges,
+            rest_curvature: vec![[0.0; 2]; n],
+            rest_twist: vec![0.0; n],
+            ref_twist: vec![0.0; n],
+            edge_file_order: (0..n).collect(),
+        }
+    }
+
     /// Number of vertices (= number of edges).
     pub fn len(&self) -> usize {
         self.positions.len()
