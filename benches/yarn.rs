@@ -13,7 +13,7 @@ use hylc::pattern::Pattern;
 use hylc::rod::bend_twist::{bend_twist_value, bend_twist_vgh, BendTwistParams, StencilFrames};
 use hylc::rod::frame::reference_twist_raw;
 use hylc::rod::stretch::stretch_vgh;
-use hylc::rod::{RodState, YarnMaterial};
+use hylc::rod::YarnMaterial;
 use hylc::tile::{Terms, Tile, Want};
 use nalgebra::Vector3;
 use std::hint::black_box;
@@ -126,11 +126,7 @@ fn patterns() -> Vec<(String, Pattern)> {
 fn bench_tiles(c: &mut Criterion) {
     let mut g = c.benchmark_group("tile");
     for (name, p) in patterns() {
-        let state = RodState::from_pattern(&p);
-        let mut tile = Tile::new(&p, &YarnMaterial::default());
-        tile.update_contacts(&state.positions, 0.5 * p.radius)
-            .unwrap();
-        let y = Tile::dofs_of(&state);
+        let (state, tile, y) = Tile::at_rest_state(&p, &YarnMaterial::default()).unwrap();
         let active = tile.active_contact_pairs(&y).unwrap();
         let label = format!(
             "{name} [{} vertices, {} candidate pairs, {} active]",

@@ -206,13 +206,7 @@ fn cli_reports_bad_files_in_one_line_without_panicking() {
             .replacen("\"k\": 3", "\"k\": 9", 1),
     )
     .unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
-        .args(["material", bad.to_str().unwrap(), "--z", "0,0,0,0,0,0"])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2));
-    let err = String::from_utf8(out.stderr).unwrap();
-    assert_eq!(err.lines().count(), 1, "{err}");
+    let err = common::cli_error(&["material", bad.to_str().unwrap(), "--z", "0,0,0,0,0,0"]);
     assert!(
         err.contains("bad.json")
             && err.contains("coeffs.1D[3].k")

@@ -1146,13 +1146,7 @@ fn cli_pattern_summarises_writes_and_reports_errors() {
     // bad input: exit code 2, one line naming file, block and line
     let bad_file = dir.join("bad.pyp");
     std::fs::write(&bad_file, with_line(TILE, 16, "3 0 2 0")).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
-        .args(["pattern", bad_file.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2));
-    let err = String::from_utf8(out.stderr).unwrap();
-    assert_eq!(err.lines().count(), 1, "{err}");
+    let err = common::cli_error(&["pattern", bad_file.to_str().unwrap()]);
     assert!(
         err.starts_with("error: ")
             && err.contains("bad.pyp: block *E, line 16: edge 3 has offset dx = 2"),

@@ -18,12 +18,7 @@ fn plain() -> Pattern {
 
 /// The pattern's own state, a tile with its contact pairs, and the state's dofs.
 fn tile_of(p: &Pattern) -> (RodState, Tile<'_>, Vec<f64>) {
-    let state = RodState::from_pattern(p);
-    let mut tile = Tile::new(p, &YarnMaterial::default());
-    tile.update_contacts(&state.positions, 0.5 * p.radius)
-        .unwrap();
-    let y = Tile::dofs_of(&state);
-    (state, tile, y)
+    Tile::at_rest_state(p, &YarnMaterial::default()).unwrap()
 }
 
 #[test]

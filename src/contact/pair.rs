@@ -54,6 +54,32 @@ impl PairVgh {
     }
 }
 
+/// u = ρ² = ‖d‖²/(4r²) of quadrature pair (p, q) when its term is active (u < 1), `None` beyond the cut-off;
+/// errors for a NaN distance and for an overlap below [`RHO_MIN`].
+#[inline]
+fn active_term(
+    d: &Vector3<f64>,
+    inv4r2: f64,
+    p: usize,
+    q: usize,
+) -> Result<Option<f64>, ContactError> {
+    let u = d.norm_squared() * inv4r2;
+    if u >= 1.0 {
+        return Ok(None);
+    }
+    if u.is_nan() {
+        return Err(ContactError::NonFinite);
+    }
+    if u < RHO_MIN * RHO_MIN {
+        return Err(ContactError::Overlap {
+            rho: u.sqrt(),
+            p,
+            q,
+        });
+    }
+    Ok(Some(u))
+}
+
 /// The pair kernel: contact stiffness k_c (J/m²), yarn radius r (m) and the Gauss–Legendre rule of order Q.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PairKernel {
@@ -133,20 +159,9 @@ impl PairKernel {
             let mut row = 0.0;
             for q in 0..s.len() {
                 let d = xa - (x[2] + eb * s[q]);
-                let u = d.norm_squared() * inv4r2;
-                if u >= 1.0 {
+                let Some(u) = active_term(&d, inv4r2, p, q)? else {
                     continue;
-                }
-                if u.is_nan() {
-                    return Err(ContactError::NonFinite);
-                }
-                if u < RHO_MIN * RHO_MIN {
-                    return Err(ContactError::Overlap {
-                        rho: u.sqrt(),
-                        p,
-                        q,
-                    });
-                }
+                };
                 let om = 1.0 - u;
                 row += w[q] * (om * om / u);
             }
@@ -185,20 +200,9 @@ impl PairKernel {
             let mut active = false;
             for q in 0..s.len() {
                 let d = xa - (x[2] + eb * s[q]);
-                let u = d.norm_squared() * inv4r2;
-                if u >= 1.0 {
+                let Some(u) = active_term(&d, inv4r2, p, q)? else {
                     continue;
-                }
-                if u.is_nan() {
-                    return Err(ContactError::NonFinite);
-                }
-                if u < RHO_MIN * RHO_MIN {
-                    return Err(ContactError::Overlap {
-                        rho: u.sqrt(),
-                        p,
-                        q,
-                    });
-                }
+                };
                 active = true;
                 let wt = w[p] * w[q];
                 let iu = 1.0 / u;

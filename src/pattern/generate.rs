@@ -663,42 +663,9 @@ pub fn segment_distance(
     q0: &Vector3<f64>,
     q1: &Vector3<f64>,
 ) -> f64 {
-    let d1 = p1 - p0;
-    let d2 = q1 - q0;
-    let r = p0 - q0;
-    let a = d1.norm_squared();
-    let e = d2.norm_squared();
-    let f = d2.dot(&r);
-    let tiny = f64::MIN_POSITIVE;
-    let (s, t) = if a <= tiny && e <= tiny {
-        (0.0, 0.0)
-    } else if a <= tiny {
-        (0.0, (f / e).clamp(0.0, 1.0))
-    } else {
-        let c = d1.dot(&r);
-        if e <= tiny {
-            ((-c / a).clamp(0.0, 1.0), 0.0)
-        } else {
-            let b = d1.dot(&d2);
-            let denom = a * e - b * b;
-            // parallel segments (denom ≈ 0): any s works, start from 0 and clamp below
-            let mut s = if denom > 1e-14 * a * e {
-                ((b * f - c * e) / denom).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let mut t = (b * s + f) / e;
-            if t < 0.0 {
-                t = 0.0;
-                s = (-c / a).clamp(0.0, 1.0);
-            } else if t > 1.0 {
-                t = 1.0;
-                s = ((b - c) / a).clamp(0.0, 1.0);
-            }
-            (s, t)
-        }
-    };
-    (p0 + d1 * s - q0 - d2 * t).norm()
+    crate::contact::segment_distance_squared(p0, p1, q0, q1)
+        .0
+        .sqrt()
 }
 
 /// Which segment pairs on the same (infinite, periodically continued) yarn [`min_centerline_distance`] considers.

@@ -123,11 +123,27 @@ pub fn bend_twist_value(
     energy_of(&k, p)
 }
 
+/// The bending and the twisting energy of one stencil (fast values, one kinematics evaluation).
+pub fn bend_twist_parts(
+    x: &[Vector3<f64>; 3],
+    theta: [f64; 2],
+    fr: &StencilFrames,
+    p: &BendTwistParams,
+) -> [f64; 2] {
+    parts_of(&kinematics(x, theta, fr), p)
+}
+
 fn energy_of(k: &StencilKinematics, p: &BendTwistParams) -> f64 {
+    let [b, t] = parts_of(k, p);
+    b + t
+}
+
+fn parts_of(k: &StencilKinematics, p: &BendTwistParams) -> [f64; 2] {
     let d1 = k.curvature[0] - p.rest_curvature[0];
     let d2 = k.curvature[1] - p.rest_curvature[1];
     let dm = k.twist - p.rest_twist;
-    0.5 / p.voronoi_length * (p.bend * (d1 * d1 + d2 * d2) + p.twist * dm * dm)
+    let h = 0.5 / p.voronoi_length;
+    [h * p.bend * (d1 * d1 + d2 * d2), h * p.twist * dm * dm]
 }
 
 /// Material frame jets over the 8 local variables (e⁰, e¹, θ⁰, θ¹); θ is variable `col`.
@@ -214,6 +230,17 @@ pub fn bend_twist_vgh(
     fr: &StencilFrames,
     p: &BendTwistParams,
 ) -> (f64, SVector<f64, 11>, SMatrix<f64, 11, 11>) {
+    let ([b, t], g, h) = bend_twist_parts_vgh(x, theta, fr, p);
+    (b + t, g, h)
+}
+
+/// [`bend_twist_vgh`] with the energy split into its bending and twisting parts.
+pub fn bend_twist_parts_vgh(
+    x: &[Vector3<f64>; 3],
+    theta: [f64; 2],
+    fr: &StencilFrames,
+    p: &BendTwistParams,
+) -> ([f64; 2], SVector<f64, 11>, SMatrix<f64, 11, 11>) {
     let (k1, k2, m) = kinematics_jets(x, theta, fr);
     let iv = 1.0 / p.voronoi_length;
     let mut d1 = k1;
@@ -222,11 +249,9 @@ pub fn bend_twist_vgh(
     d2.v -= p.rest_curvature[1];
     let mut dm = m;
     dm.v -= p.rest_twist;
-    let e = d1
-        .half_square()
-        .add(&d2.half_square())
-        .scale(p.bend * iv)
-        .add(&dm.half_square().scale(p.twist * iv));
+    let eb = d1.half_square().add(&d2.half_square()).scale(p.bend * iv);
+    let et = dm.half_square().scale(p.twist * iv);
+    let e = eb.add(&et);
     // local (e⁰, e¹, θ⁰, θ¹) → stencil dofs (x⁰, x¹, x², θ⁰, θ¹): e⁰ = x¹ − x⁰, e¹ = x² − x¹
     let mut map = SMatrix::<f64, 8, 11>::zeros();
     for a in 0..3 {
@@ -239,7 +264,7 @@ pub fn bend_twist_vgh(
     map[(7, 10)] = 1.0;
     let g = map.transpose() * e.g;
     let h = map.transpose() * e.h * map;
-    (e.v, g, h)
+    ([eb.v, et.v], g, h)
 }
 
 /// Reference twin: the energy of the stencil, generic over the scalar, written like `02-yarn-model.md`.

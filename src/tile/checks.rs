@@ -33,12 +33,10 @@ pub struct TileCheck {
 impl TileCheck {
     /// A check on `pattern` with its contact pairs found at the pattern's state.
     pub fn new(name: &str, pattern: Pattern, material: &YarnMaterial) -> Self {
-        let frames = RodState::from_pattern(&pattern);
-        let (contacts, material) = {
-            let mut tile = Tile::new(&pattern, material);
-            tile.update_contacts(&frames.positions, 0.5 * pattern.radius)
+        let (frames, contacts, material) = {
+            let (frames, tile, _) = Tile::at_rest_state(&pattern, material)
                 .expect("the embedded harness patterns have finite positions");
-            (tile.contacts.clone(), tile.material.clone())
+            (frames, tile.contacts.clone(), tile.material.clone())
         };
         let rule = GaussLegendre::new(material.contact_quadrature);
         TileCheck {

@@ -5,6 +5,8 @@ use super::{Tile, Want};
 use crate::contact::{
     tile_segments, BroadPhase, ContactError, PairKernel, SegmentTopology, TileImages,
 };
+use crate::pattern::Pattern;
+use crate::rod::{RodState, YarnMaterial};
 use nalgebra::{DVector, Vector3};
 use rayon::prelude::*;
 
@@ -85,7 +87,23 @@ pub(super) fn assemble(
     Ok(total)
 }
 
+/// Broad-phase margin of [`Tile::at_rest_state`] in units of the yarn radius.
+pub const DEFAULT_MARGIN: f64 = 0.5;
+
 impl<'a> Tile<'a> {
+    /// The pattern's own rod state, a tile on it with its contact pairs found there (margin
+    /// [`DEFAULT_MARGIN`]·r), and the state's dofs: the set-up every evaluation at a pattern's stored state needs.
+    pub fn at_rest_state(
+        pattern: &'a Pattern,
+        material: &YarnMaterial,
+    ) -> Result<(RodState, Self, Vec<f64>), ContactError> {
+        let state = RodState::from_pattern(pattern);
+        let mut tile = Tile::new(pattern, material);
+        tile.update_contacts(&state.positions, DEFAULT_MARGIN * pattern.radius)?;
+        let y = Tile::dofs_of(&state);
+        Ok((state, tile, y))
+    }
+
     /// Find the contact pairs of the tile at `positions` with the BVH broad phase (`crate::contact::broad`): every
     /// pair of segments closer than 2r + `margin` that is not excluded along its yarn, each physical pair once.
     /// The list stays complete while no vertex moves by more than `margin / 2`.

@@ -16,7 +16,7 @@ pub use contact::ContactPair;
 
 use crate::contact::ContactError;
 use crate::pattern::Pattern;
-use crate::rod::bend_twist::{bend_twist_value, bend_twist_vgh, BendTwistParams};
+use crate::rod::bend_twist::{bend_twist_parts, bend_twist_parts_vgh, BendTwistParams};
 use crate::rod::stretch::{stretch_value, stretch_vgh};
 use crate::rod::{Placement, RodState, RodTopology, Translation, YarnMaterial};
 use nalgebra::{DVector, Matrix3, Vector3};
@@ -232,23 +232,28 @@ impl<'a> Tile<'a> {
                     let th = [y[3 * n + s.edges[0]], y[3 * n + s.edges[1]]];
                     let (_, _, fr) = frames.stencil(s, &self.placement);
                     let p = self.bend_params(i, terms);
-                    // the bending and twisting parts separately, for reporting
-                    let pb = BendTwistParams { twist: 0.0, ..p };
-                    let eb = bend_twist_value(&x, th, &fr, &pb);
                     if want == Want::Value {
-                        let v = bend_twist_value(&x, th, &fr, &p);
+                        let [eb, et] = bend_twist_parts(&x, th, &fr, &p);
                         (
                             eb,
-                            v - eb,
+                            et,
                             Local {
-                                value: v,
+                                value: eb + et,
                                 g: Default::default(),
                                 h: Default::default(),
                             },
                         )
                     } else {
-                        let (value, g, h) = bend_twist_vgh(&x, th, &fr, &p);
-                        (eb, value - eb, Local { value, g, h })
+                        let ([eb, et], g, h) = bend_twist_parts_vgh(&x, th, &fr, &p);
+                        (
+                            eb,
+                            et,
+                            Local {
+                                value: eb + et,
+                                g,
+                                h,
+                            },
+                        )
                     }
                 })
                 .collect();

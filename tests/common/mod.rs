@@ -24,3 +24,16 @@ pub fn rel_norm(a: &[f64], b: &[f64]) -> f64 {
     let n: f64 = b.iter().map(|y| y * y).sum::<f64>().sqrt();
     d / n.max(f64::MIN_POSITIVE)
 }
+
+/// Run the `hylc` binary with `args`, assert that it fails with exit code 2 and a one-line message, and return
+/// that message (stderr).
+pub fn cli_error(args: &[&str]) -> String {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hylc"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    err
+}
