@@ -7,6 +7,7 @@
 pub mod contact;
 pub mod diff;
 pub mod material;
+pub mod micro;
 pub mod pattern;
 pub mod rod;
 pub mod tile;

@@ -2,6 +2,8 @@
 
 #[path = "hylc/calibrate.rs"]
 mod calibrate;
+#[path = "hylc/micro.rs"]
+mod micro;
 
 use clap::{Parser, Subcommand};
 use hylc::diff::{format_table, run_all, CheckConfig};
@@ -94,6 +96,45 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Solve the micro problem of a pattern at one or more macro strains (warm-started from the previous one
+    /// unless --cold): status, Newton steps, Ψ̄, homogenized stress, time and where it went.
+    Solve {
+        /// `.pyp` file, or a generated kind (plain, twill, satin, basket, stockinette)
+        pattern: String,
+        /// strain s_x,s_a,s_y[,II00,II11] (repeatable; default zero)
+        #[arg(long = "z", allow_hyphen_values = true)]
+        z: Vec<String>,
+        /// start every strain from the reference state
+        #[arg(long)]
+        cold: bool,
+        /// force tolerance relative to the stretching stiffness
+        #[arg(long, default_value_t = 1e-8)]
+        tolerance: f64,
+        /// Newton step limit
+        #[arg(long, default_value_t = 2000)]
+        max_steps: usize,
+        /// displacement limit factor (times r λ_min(I))
+        #[arg(long, default_value_t = 1.0)]
+        step_factor: f64,
+        /// no per-yarn slide constraints
+        #[arg(long)]
+        no_slide_constraints: bool,
+        /// write the yarn centre lines as OBJ polylines (one file per strain when several)
+        #[arg(long)]
+        obj: Option<PathBuf>,
+        /// one JSON object per strain
+        #[arg(long)]
+        json: bool,
+    },
+    /// Ψ̄ at one strain with its derivatives with respect to the strain and to the yarn parameters (envelope
+    /// theorem).
+    Sensitivity {
+        /// `.pyp` file or generated kind
+        pattern: String,
+        /// strain s_x,s_a,s_y[,II00,II11]
+        #[arg(long = "z", allow_hyphen_values = true, default_value = "0,0,0")]
+        z: String,
+    },
     /// Calibrate the yarn parameters so that the original reference patterns are static equilibria: per contact
     /// form, the residual force at the defaults, the best parameters per pattern and the joint fit.
     Calibrate {
@@ -147,6 +188,35 @@ fn main() -> ExitCode {
             obj.as_deref(),
             out.as_deref(),
         ),
+        Command::Solve {
+            pattern,
+            z,
+            cold,
+            tolerance,
+            max_steps,
+            step_factor,
+            no_slide_constraints,
+            obj,
+            json,
+        } => {
+            let options = hylc::micro::SolverOptions {
+                tolerance,
+                max_steps,
+                step_factor,
+                slide_constraints: !no_slide_constraints,
+                ..Default::default()
+            };
+            micro::solve(&pattern, &z, cold, options, obj.as_deref(), json).map(|ok| {
+                if ok {
+                    ExitCode::SUCCESS
+                } else {
+                    ExitCode::from(3)
+                }
+            })
+        }
+        Command::Sensitivity { pattern, z } => {
+            micro::sensitivity(&pattern, &z, Default::default()).map(|_| ExitCode::SUCCESS)
+        }
         Command::Calibrate {
             dir,
             quadrature,

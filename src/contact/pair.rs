@@ -170,6 +170,35 @@ impl PairKernel {
         Ok(self.stiffness * rest_a * rest_b * acc)
     }
 
+    /// ∂E_ab/∂r at fixed points: with u = d²/(4r²) each term (1 − u)²/u changes by 2(1 − u²)/(u r) per unit
+    /// radius (the yarn-radius sensitivity of `03-homogenization.md`, section 5).
+    pub fn radius_derivative(
+        &self,
+        x: &[Vector3<f64>; 4],
+        rest_a: f64,
+        rest_b: f64,
+    ) -> Result<f64, ContactError> {
+        if self.beyond_cutoff(x) {
+            return Ok(0.0);
+        }
+        let inv4r2 = 0.25 / (self.radius * self.radius);
+        let (s, w) = (self.rule.nodes(), self.rule.weights());
+        let ea = x[1] - x[0];
+        let eb = x[3] - x[2];
+        let mut acc = 0.0;
+        for p in 0..s.len() {
+            let xa = x[0] + ea * s[p];
+            for q in 0..s.len() {
+                let d = xa - (x[2] + eb * s[q]);
+                let Some(u) = active_term(&d, inv4r2, p, q)? else {
+                    continue;
+                };
+                acc += w[p] * w[q] * 2.0 * (1.0 - u * u) / (u * self.radius);
+            }
+        }
+        Ok(self.stiffness * rest_a * rest_b * acc)
+    }
+
     /// E_ab with its gradient and exact Hessian with respect to (x_a0, x_a1, x_b0, x_b1).
     pub fn value_gradient_hessian(
         &self,
@@ -323,6 +352,27 @@ pub fn pair_energy_reference<D: Real>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn radius_derivative_matches_differences() {
+        let x = [
+            Vector3::new(-2e-3, 0.0, 0.0),
+            Vector3::new(2e-3, 0.0, 0.0),
+            Vector3::new(0.0, -2e-3, 1.4e-3),
+            Vector3::new(0.0, 2e-3, 1.4e-3),
+        ];
+        let k = |r: f64| PairKernel::new(76.0, r, 4).unwrap();
+        let r = 1e-3;
+        let h = 1e-9;
+        let fd = (k(r + h).value(&x, 2e-3, 3e-3).unwrap()
+            - k(r - h).value(&x, 2e-3, 3e-3).unwrap())
+            / (2.0 * h);
+        let an = k(r).radius_derivative(&x, 2e-3, 3e-3).unwrap();
+        assert!(
+            an > 0.0 && (an - fd).abs() <= 1e-6 * an.abs(),
+            "{an} vs {fd}"
+        );
+    }
 
     fn crossing(gap: f64) -> [Vector3<f64>; 4] {
         [

@@ -15,5 +15,5 @@ pub use checks::diff_checks;
 pub use material::YarnMaterial;
 pub use state::{
     raw_reference_twists, set_rest_to_current, Placement, RodState, RodTopology, StencilDofs,
-    Translation,
+    TileTransforms, Translation, MAX_OFFSET,
 };

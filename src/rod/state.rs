@@ -37,6 +37,85 @@ impl Placement for Translation {
     }
 }
 
+/// Largest periodic offset |oᵢ| a [`TileTransforms`] table holds: edges reach ±1 and contact images a further ±1.
+pub const MAX_OFFSET: i32 = 3;
+
+/// Rigid tile transforms T_o(x) = R_o x + t_o of the periodic copies, tabulated for offsets |oᵢ| ≤
+/// [`MAX_OFFSET`] (`03-homogenization.md`, section 1: φ(ξ + (o₁p₁, o₂p₂)) = T_o φ(ξ)). Translations at zero
+/// macro strain; rotations about the cylinder axis for the bending maps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TileTransforms {
+    table: Vec<(Matrix3<f64>, Vector3<f64>)>,
+}
+
+impl TileTransforms {
+    const SIDE: i32 = 2 * MAX_OFFSET + 1;
+
+    /// The transforms given by `f(offset) = (R, t)`.
+    pub fn from_fn(f: impl Fn([i32; 2]) -> (Matrix3<f64>, Vector3<f64>)) -> Self {
+        let mut table = Vec::with_capacity((Self::SIDE * Self::SIDE) as usize);
+        for dy in -MAX_OFFSET..=MAX_OFFSET {
+            for dx in -MAX_OFFSET..=MAX_OFFSET {
+                table.push(f([dx, dy]));
+            }
+        }
+        TileTransforms { table }
+    }
+
+    /// Translations by (o₁p₁, o₂p₂, 0): the flat tile at zero macro strain.
+    pub fn flat(periods: [f64; 2]) -> Self {
+        let t = Translation { periods };
+        Self::from_fn(|o| (Matrix3::identity(), t.position(&Vector3::zeros(), o)))
+    }
+
+    /// (R, t) of offset `o`. Offsets beyond [`MAX_OFFSET`] do not occur for validated patterns (a bug if they do).
+    pub fn get(&self, o: [i32; 2]) -> &(Matrix3<f64>, Vector3<f64>) {
+        assert!(
+            o[0].abs() <= MAX_OFFSET && o[1].abs() <= MAX_OFFSET,
+            "tile offset {o:?} beyond the tabulated range"
+        );
+        let k = (o[1] + MAX_OFFSET) * Self::SIDE + (o[0] + MAX_OFFSET);
+        &self.table[k as usize]
+    }
+
+    /// The home tile and its 8 neighbours as broad-phase images.
+    pub fn images(&self) -> crate::contact::TileImages {
+        let mut v = vec![crate::contact::TileImage::identity()];
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                if (dx, dy) != (0, 0) {
+                    let (r, t) = self.get([dx, dy]);
+                    v.push(crate::contact::TileImage {
+                        offset: [dx, dy],
+                        rotation: *r,
+                        translation: *t,
+                    });
+                }
+            }
+        }
+        crate::contact::TileImages::new(v)
+            .expect("tile transforms are rigid and closed under negation")
+    }
+}
+
+impl Placement for TileTransforms {
+    #[inline]
+    fn position(&self, x: &Vector3<f64>, o: [i32; 2]) -> Vector3<f64> {
+        if o == [0, 0] {
+            return *x;
+        }
+        let (r, t) = self.get(o);
+        r * x + t
+    }
+    #[inline]
+    fn rotation(&self, o: [i32; 2]) -> Matrix3<f64> {
+        if o == [0, 0] {
+            return Matrix3::identity();
+        }
+        self.get(o).0
+    }
+}
+
 /// Negated offset.
 pub fn neg(o: [i32; 2]) -> [i32; 2] {
     [-o[0], -o[1]]
@@ -133,6 +212,22 @@ impl RodState {
         theta: Vec<f64>,
         place: &P,
     ) {
+        self.advance_between(p, topo, positions, theta, place, place)
+    }
+
+    /// [`advance`](Self::advance) while the tile transforms also change from `old` to `new` (a change of macro
+    /// strain): the copies' stored frames are those of `old`, their new frames those of `new`, and the reference
+    /// twists are continued across the change. The change must be small (each copy rotating by well under π);
+    /// larger changes are made in steps.
+    pub fn advance_between<P: Placement, Q: Placement>(
+        &mut self,
+        p: &Pattern,
+        topo: &RodTopology,
+        positions: Vec<Vector3<f64>>,
+        theta: Vec<f64>,
+        old: &P,
+        place: &Q,
+    ) {
         let tangents = edge_tangents(p, &positions, place);
         let directors: Vec<Vector3<f64>> = (0..p.len())
             .map(|j| {
@@ -146,10 +241,11 @@ impl RodState {
             .iter()
             .map(|s| {
                 let (a, b) = (s.edges[0], s.edges[1]);
+                let r_old = old.rotation(s.offsets[0]);
                 let r0 = place.rotation(s.offsets[0]);
                 let old = reference_twist_raw(
-                    &(r0 * self.tangents[a]),
-                    &(r0 * self.directors[a]),
+                    &(r_old * self.tangents[a]),
+                    &(r_old * self.directors[a]),
                     &self.tangents[b],
                     &self.directors[b],
                 );

@@ -2,9 +2,7 @@
 //! (`02-yarn-model.md`, "Yarn-yarn contact").
 
 use super::{Tile, Want};
-use crate::contact::{
-    tile_segments, BroadPhase, ContactError, PairKernel, SegmentTopology, TileImages,
-};
+use crate::contact::{tile_segments, BroadPhase, ContactError, PairKernel, SegmentTopology};
 use crate::pattern::Pattern;
 use crate::rod::{RodState, YarnMaterial};
 use nalgebra::{DVector, Vector3};
@@ -112,7 +110,7 @@ impl<'a> Tile<'a> {
         positions: &[Vector3<f64>],
         margin: f64,
     ) -> Result<(), ContactError> {
-        let images = TileImages::flat(self.pattern.periods);
+        let images = self.placement.images();
         let segments = tile_segments(self.pattern, positions, &images)?;
         let broad = BroadPhase::new(
             &segments,

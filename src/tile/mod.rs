@@ -18,7 +18,7 @@ use crate::contact::ContactError;
 use crate::pattern::Pattern;
 use crate::rod::bend_twist::{bend_twist_parts, bend_twist_parts_vgh, BendTwistParams};
 use crate::rod::stretch::{stretch_value, stretch_vgh};
-use crate::rod::{Placement, RodState, RodTopology, Translation, YarnMaterial};
+use crate::rod::{Placement, RodState, RodTopology, TileTransforms, YarnMaterial};
 use nalgebra::{DVector, Matrix3, Vector3};
 use rayon::prelude::*;
 
@@ -108,6 +108,15 @@ impl TileEval {
     }
 }
 
+/// How a vertex's three position dofs place it (`03-homogenization.md`, section 2): the home copy of vertex v is
+/// at x_v = b_v + R_v ũ_v (b_v = φ(ξ_v) + h_v n(ξ_v), R_v = R(ξ_v)), and its copy at offset o at T_o(x_v).
+/// Without a map the dofs are the home positions themselves.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DofMap {
+    pub base: Vec<Vector3<f64>>,
+    pub rotation: Vec<Matrix3<f64>>,
+}
+
 /// A periodic tile ready to evaluate: the pattern's rest values, the material, the rod topology and the contact
 /// pairs.
 pub struct Tile<'a> {
@@ -115,7 +124,10 @@ pub struct Tile<'a> {
     pub material: YarnMaterial,
     pub topology: RodTopology,
     pub voronoi: Vec<f64>,
-    pub placement: Translation,
+    /// The rigid transforms of the periodic copies.
+    pub placement: TileTransforms,
+    /// The per-vertex dof map (none: dofs are world positions).
+    pub dof_map: Option<DofMap>,
     pub contacts: Vec<ContactPair>,
     /// Radius of the contact distance 2r (the yarn radius unless a calibration varies it).
     pub contact_radius: f64,
@@ -138,9 +150,8 @@ impl<'a> Tile<'a> {
             material,
             topology: RodTopology::new(pattern),
             voronoi: pattern.voronoi_lengths(),
-            placement: Translation {
-                periods: pattern.periods,
-            },
+            placement: TileTransforms::flat(pattern.periods),
+            dof_map: None,
             contacts: Vec::new(),
             contact_radius: pattern.radius,
         }
@@ -162,10 +173,35 @@ impl<'a> Tile<'a> {
         y
     }
 
+    /// World position of the home copy of vertex `v` for dofs `y`.
+    #[inline]
+    pub fn home(&self, y: &[f64], v: usize) -> Vector3<f64> {
+        let u = Vector3::new(y[3 * v], y[3 * v + 1], y[3 * v + 2]);
+        match &self.dof_map {
+            None => u,
+            Some(m) => m.base[v] + m.rotation[v] * u,
+        }
+    }
+
+    /// World positions of all home vertices for dofs `y`.
+    pub fn home_positions(&self, y: &[f64]) -> Vec<Vector3<f64>> {
+        (0..self.pattern.len()).map(|v| self.home(y, v)).collect()
+    }
+
     /// World position of the copy at offset `o` of vertex `v` for dofs `y`.
+    #[inline]
     pub fn position(&self, y: &[f64], v: usize, o: [i32; 2]) -> Vector3<f64> {
-        let x = Vector3::new(y[3 * v], y[3 * v + 1], y[3 * v + 2]);
-        self.placement.position(&x, o)
+        self.placement.position(&self.home(y, v), o)
+    }
+
+    /// The rotation from vertex `v`'s position dofs to its copy at offset `o`: R_o R_v.
+    #[inline]
+    pub fn dof_rotation(&self, v: usize, o: [i32; 2]) -> Matrix3<f64> {
+        let r = self.placement.rotation(o);
+        match &self.dof_map {
+            None => r,
+            Some(m) => r * m.rotation[v],
+        }
     }
 
     pub(crate) fn bend_params(&self, i: usize, terms: &Terms) -> BendTwistParams {
@@ -277,6 +313,102 @@ impl<'a> Tile<'a> {
         })
     }
 
+    /// Force and moment resultants of the stencil forces acting on periodic copies, per offset o ≠ 0: F_o = Σ g,
+    /// M_o = Σ x × g over the stencil points at offset o (g = ∂E/∂x of the stencil at that point, world
+    /// coordinates), plus, for each bending stencil whose incoming edge is a copy, g_θ⁰ t⁰ added to M of that
+    /// copy's offset (the copy's stored frame turns with its tile transform: to first order at the stored state
+    /// the same as turning θ⁰ by ω·t⁰). With an infinitesimal change of the tile transforms δx = ω_o × x + v_o,
+    /// the energy changes by Σ_o ω_o·M_o + v_o·F_o at fixed dofs (`03-homogenization.md`, section 5; used for the
+    /// envelope-theorem stress).
+    pub fn offset_resultants(
+        &self,
+        frames: &RodState,
+        y: &[f64],
+        terms: &Terms,
+    ) -> Result<Vec<([i32; 2], Vector3<f64>, Vector3<f64>)>, ContactError> {
+        use std::collections::BTreeMap;
+        let n = self.pattern.len();
+        let mut acc = BTreeMap::new();
+        type Acc = BTreeMap<[i32; 2], (Vector3<f64>, Vector3<f64>)>;
+        fn add(acc: &mut Acc, o: [i32; 2], x: &Vector3<f64>, g: &Vector3<f64>) {
+            let e = acc.entry(o).or_insert((Vector3::zeros(), Vector3::zeros()));
+            e.0 += g;
+            e.1 += x.cross(g);
+        }
+        if terms.stretch != 0.0 {
+            let ks = self.material.stretch_stiffness() * terms.stretch;
+            for (i, e) in self.pattern.edges.iter().enumerate() {
+                if e.offset == [0, 0] {
+                    continue;
+                }
+                let a = self.position(y, i, [0, 0]);
+                let b = self.position(y, e.end, e.offset);
+                let (_, g, _) = stretch_vgh(&a, &b, e.rest_length, ks);
+                add(&mut acc, e.offset, &b, &g.fixed_rows::<3>(3).into_owned());
+            }
+        }
+        if terms.bend != 0.0 || terms.twist != 0.0 {
+            for (i, s) in self.topology.stencils.iter().enumerate() {
+                if s.offsets.iter().all(|o| *o == [0, 0]) {
+                    continue;
+                }
+                let x = [0, 1, 2].map(|k| self.position(y, s.vertices[k], s.offsets[k]));
+                let th = [y[3 * n + s.edges[0]], y[3 * n + s.edges[1]]];
+                let (_, _, fr) = frames.stencil(s, &self.placement);
+                let (_, g, _) = bend_twist_parts_vgh(&x, th, &fr, &self.bend_params(i, terms));
+                for k in 0..3 {
+                    if s.offsets[k] != [0, 0] {
+                        add(
+                            &mut acc,
+                            s.offsets[k],
+                            &x[k],
+                            &g.fixed_rows::<3>(3 * k).into_owned(),
+                        );
+                    }
+                }
+                if s.offsets[0] != [0, 0] {
+                    let t0 = (x[1] - x[0]).normalize();
+                    let e = acc
+                        .entry(s.offsets[0])
+                        .or_insert((Vector3::zeros(), Vector3::zeros()));
+                    e.1 += t0 * g[9];
+                }
+            }
+        }
+        if terms.contact != 0.0 && !self.contacts.is_empty() {
+            let m = &self.material;
+            let kernel = crate::contact::PairKernel::new(
+                m.contact_stiffness * terms.contact,
+                self.contact_radius,
+                m.contact_quadrature,
+            )?;
+            for pair in &self.contacts {
+                let pts = pair.points(self);
+                if pts.iter().all(|(_, o)| *o == [0, 0]) {
+                    continue;
+                }
+                let x: [Vector3<f64>; 4] = pts.map(|(v, o)| self.position(y, v, o));
+                if kernel.beyond_cutoff(&x) {
+                    continue;
+                }
+                let la = self.pattern.edges[pair.a].rest_length;
+                let lb = self.pattern.edges[pair.b].rest_length;
+                let r = kernel.value_gradient_hessian(&x, la, lb)?;
+                for k in 0..4 {
+                    if pts[k].1 != [0, 0] {
+                        add(
+                            &mut acc,
+                            pts[k].1,
+                            &x[k],
+                            &r.gradient.fixed_rows::<3>(3 * k).into_owned(),
+                        );
+                    }
+                }
+            }
+        }
+        Ok(acc.into_iter().map(|(o, (f, m))| (o, f, m)).collect())
+    }
+
     /// Add a stencil's local gradient and Hessian: `pos` lists (vertex, offset) for consecutive 3-blocks of the
     /// local dofs, `angles` the edges of the angle dofs that follow them.
     fn scatter_positions<const N: usize>(
@@ -290,10 +422,7 @@ impl<'a> Tile<'a> {
         let n = self.pattern.len();
         // global index of local dof k and the rotation of its block
         let np = pos.len();
-        let rot: Vec<Matrix3<f64>> = pos
-            .iter()
-            .map(|&(_, o)| self.placement.rotation(o))
-            .collect();
+        let rot: Vec<Matrix3<f64>> = pos.iter().map(|&(v, o)| self.dof_rotation(v, o)).collect();
         if let Some(g) = grad.as_mut() {
             for (b, &(v, _)) in pos.iter().enumerate() {
                 let gb = rot[b].transpose() * l.g.fixed_rows::<3>(3 * b);

@@ -1,0 +1,204 @@
+//! `hylc solve`, `hylc reference`, `hylc sensitivity`: the micro solver on one pattern
+//! (`03-homogenization.md`; `hylc::micro`).
+
+use hylc::micro::envelope::{parameter_derivatives, strain_derivatives, PARAMETER_NAMES};
+use hylc::micro::solver::world_positions;
+use hylc::micro::strain::STRAIN_NAMES;
+use hylc::micro::{MacroStrain, MicroProblem, Solution, SolverOptions};
+use hylc::pattern::generate::default_pattern;
+use hylc::pattern::Pattern;
+use hylc::rod::YarnMaterial;
+use serde_json::json;
+use std::path::Path;
+
+/// A pattern from a `.pyp` file, or a generated one by kind name (`plain`, `twill`, `satin`, `basket`,
+/// `stockinette`). A file whose periods disagree with its rest lengths is used at the implied periods (with a
+/// note on stderr).
+pub fn load_pattern(arg: &str) -> Result<Pattern, String> {
+    let path = Path::new(arg);
+    if path.extension().is_some_and(|e| e == "pyp") || path.exists() {
+        let (mut p, warnings) = Pattern::load_pyp(path).map_err(|e| e.to_string())?;
+        if !warnings.is_empty() {
+            if let Some(implied) = p.implied_periods() {
+                eprintln!(
+                    "note: {arg}: periods {:?} disagree with the rest lengths; using the implied periods {:?}",
+                    p.periods, implied
+                );
+                p.periods = implied;
+            }
+        }
+        Ok(p)
+    } else {
+        default_pattern(arg).map_err(|e| format!("{arg}: not a file, and {e}"))
+    }
+}
+
+/// Parse "sx,sa,sy[,II00,II11]".
+pub fn parse_strain(text: &str) -> Result<MacroStrain, String> {
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|s| {
+            s.trim()
+                .parse::<f64>()
+                .map_err(|_| format!("--z: cannot parse {s:?} in {text:?}"))
+        })
+        .collect::<Result<_, _>>()?;
+    match v.len() {
+        3 => Ok(MacroStrain::in_plane(v[0], v[1], v[2])),
+        5 => Ok(MacroStrain::new(v[0], v[1], v[2], v[3], v[4])),
+        k => Err(format!(
+            "--z: expected 3 (s_x,s_a,s_y) or 5 (s_x,s_a,s_y,II00,II11) numbers, got {k} in {text:?}"
+        )),
+    }
+}
+
+fn report(problem: &MicroProblem, sol: &Solution) -> serde_json::Value {
+    let t = &sol.timings;
+    let stress = strain_derivatives(problem, &sol.state).ok();
+    json!({
+        "strain": sol.state.strain.0,
+        "status": sol.status.to_string(),
+        "psi": sol.psi().ok(),
+        "energy": {
+            "stretch": sol.energy.stretch, "bend": sol.energy.bend,
+            "twist": sol.energy.twist, "contact": sol.energy.contact,
+        },
+        "stress": stress.map(|s| STRAIN_NAMES.iter().zip(s).map(|(n, v)| (n.to_string(), json!(v))).collect::<serde_json::Map<_, _>>()),
+        "steps": sol.steps,
+        "gradient_norm": sol.gradient_norm,
+        "time": sol.time,
+        "timings": { "start": t.start, "assembly": t.assembly, "contact": t.contact,
+                     "factorization": t.factorization, "line_search": t.line_search },
+    })
+}
+
+/// `hylc solve`.
+#[allow(clippy::too_many_arguments)]
+pub fn solve(
+    pattern: &str,
+    z: &[String],
+    cold: bool,
+    options: SolverOptions,
+    obj: Option<&Path>,
+    json_out: bool,
+) -> Result<bool, String> {
+    let p = load_pattern(pattern)?;
+    let problem = MicroProblem::new(p, &YarnMaterial::default(), options);
+    let strains: Vec<MacroStrain> = if z.is_empty() {
+        vec![MacroStrain::ZERO]
+    } else {
+        z.iter()
+            .map(|s| parse_strain(s))
+            .collect::<Result<_, _>>()?
+    };
+    let mut all_ok = true;
+    let mut prev: Option<Solution> = None;
+    for (k, strain) in strains.iter().enumerate() {
+        let start = if cold {
+            None
+        } else {
+            prev.as_ref().map(|s| &s.state)
+        };
+        let sol = problem.solve(strain, start).map_err(|e| e.to_string())?;
+        let r = report(&problem, &sol);
+        if json_out {
+            println!("{r}");
+        } else {
+            println!(
+                "z = {}: {} in {} steps, {:.3} s; Ψ̄ = {}; ‖g‖∞ = {:.2e} N",
+                strain,
+                sol.status,
+                sol.steps,
+                sol.time,
+                sol.psi()
+                    .map(|v| format!("{v:.6e} J/m²"))
+                    .unwrap_or_else(|e| format!("none ({e})")),
+                sol.gradient_norm
+            );
+            if let Some(s) = r["stress"].as_object() {
+                let parts: Vec<String> = s
+                    .iter()
+                    .map(|(n, v)| {
+                        format!(
+                            "{n} {}",
+                            v.as_f64().map(|x| format!("{x:.5e}")).unwrap_or("-".into())
+                        )
+                    })
+                    .collect();
+                println!("  stress ∂Ψ̄/∂z: {}", parts.join(", "));
+            }
+            let t = &sol.timings;
+            println!(
+                "  time: start {:.3} s, assembly {:.3} s, contact {:.3} s, factorisation {:.3} s, line search {:.3} s",
+                t.start, t.assembly, t.contact, t.factorization, t.line_search
+            );
+        }
+        all_ok &= sol.psi().is_ok();
+        if let Some(path) = obj {
+            let path = if strains.len() > 1 {
+                path.with_extension(format!("{k}.obj"))
+            } else {
+                path.to_path_buf()
+            };
+            write_obj(&problem, &sol, &path)?;
+        }
+        prev = Some(sol);
+    }
+    Ok(all_ok)
+}
+
+/// The yarn centre lines of a solution as OBJ polylines (one `l` element per yarn, home tile).
+pub fn write_obj(problem: &MicroProblem, sol: &Solution, path: &Path) -> Result<(), String> {
+    let p = &problem.pattern;
+    let x = world_positions(p, &sol.state);
+    let mut s = String::new();
+    s.push_str(&format!("# hylc solve: strain {}\n", sol.state.strain));
+    for v in &x {
+        s.push_str(&format!("v {} {} {}\n", v.x, v.y, v.z));
+    }
+    let elim = hylc::micro::Elimination::in_family(p, &sol.state.strain, sol.state.family);
+    let mut extra = x.len();
+    for yarn in p.yarns() {
+        let mut line = String::from("l");
+        for &v in &yarn {
+            line.push_str(&format!(" {}", v + 1));
+        }
+        // close the yarn through the copy of its first vertex when it leaves the tile
+        let last = *yarn.last().expect("yarns are non-empty");
+        let e = &p.edges[last];
+        if e.offset == [0, 0] {
+            line.push_str(&format!(" {}", e.end + 1));
+        } else {
+            let u = hylc::micro::solver::local(&sol.state.y, e.end);
+            let c = elim.position(e.end, e.offset, &u);
+            s.push_str(&format!("v {} {} {}\n", c.x, c.y, c.z));
+            extra += 1;
+            line.push_str(&format!(" {extra}"));
+        }
+        s.push_str(&line);
+        s.push('\n');
+    }
+    std::fs::write(path, s).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// `hylc sensitivity`: Ψ̄ and its derivatives with respect to the strain and the yarn parameters at one strain.
+pub fn sensitivity(pattern: &str, z: &str, options: SolverOptions) -> Result<bool, String> {
+    let p = load_pattern(pattern)?;
+    let problem = MicroProblem::new(p, &YarnMaterial::default(), options);
+    let strain = parse_strain(z)?;
+    let sol = problem.solve(&strain, None).map_err(|e| e.to_string())?;
+    let psi = sol.psi().map_err(|e| e.to_string())?;
+    let ds = strain_derivatives(&problem, &sol.state).map_err(|e| e.to_string())?;
+    let dp = parameter_derivatives(&problem, &sol).map_err(|e| e.to_string())?;
+    println!("Ψ̄ = {psi:.6e} J/m² ({} steps)", sol.steps);
+    for (n, v) in STRAIN_NAMES.iter().zip(ds) {
+        match v {
+            Some(v) => println!("  ∂Ψ̄/∂{n} = {v:.6e}"),
+            None => println!("  ∂Ψ̄/∂{n}: not available (bending along the other axis)"),
+        }
+    }
+    for (n, v) in PARAMETER_NAMES.iter().zip(dp) {
+        println!("  ∂Ψ̄/∂{n} = {v:.6e}");
+    }
+    Ok(true)
+}

@@ -1,0 +1,152 @@
+//! Derivatives of Ψ̄ at an equilibrium by the envelope theorem (`03-homogenization.md`, section 5):
+//! dΨ̄/dp = (1/(p₁p₂)) ∂E/∂p (y*, p) at fixed unknowns, for the strain components and the yarn parameters.
+//!
+//! Strain: at fixed y every vertex copy moves with the map, x = T_o(b_v(z) + R_v(z) ũ_v). Split into the motion
+//! of the home copies (contracted with the assembled gradient in world coordinates) and the change of the tile
+//! transforms, δx = ω_o × x + v_o per offset o (contracted with the force and moment resultants of the stencils
+//! on copies, [`Tile::offset_resultants`], which include the turning of the copies' stored frames). The
+//! z-derivatives of b_v, R_v and T_o come from num-dual through the generic surface maps.
+//!
+//! Parameters: the rod energies are linear in Y (stretching, bending), G (twisting), γ (bending and twisting) and
+//! k_c (contact), so their derivatives are the energies of the same state with that parameter set to 1; the
+//! radius enters as r² (stretching), r⁴ (bending, twisting) and through the contact kernel
+//! ([`PairKernel::radius_derivative`]).
+
+use super::elimination::Elimination;
+use super::solver::{local, MicroError, MicroProblem, MicroState, Solution};
+use super::strain::Family;
+use super::surface::SurfaceMap;
+use crate::contact::PairKernel;
+use crate::tile::{Terms, Tile, Want};
+use nalgebra::{Matrix3, Vector3};
+use num_dual::Dual64;
+
+/// The yarn parameters of [`parameter_derivatives`], in order.
+pub const PARAMETER_NAMES: [&str; 5] = [
+    "young",
+    "shear",
+    "bend_twist_factor",
+    "contact_stiffness",
+    "radius",
+];
+
+/// ∂E/∂z_j (J per unit strain, one tile) at fixed unknowns of a state in its family, for the components that
+/// family parametrises (`BendY`: s_x, s_a, s_y, Π₁₁; `BendX`: s_x, s_a, s_y, Π₀₀; the other entry is `None`).
+pub fn energy_strain_gradient(
+    problem: &MicroProblem,
+    state: &MicroState,
+) -> Result<[Option<f64>; 5], MicroError> {
+    let p = &problem.pattern;
+    let n = p.len();
+    let elim = Elimination::in_family(p, &state.strain, state.family);
+    let mut tile: Tile = problem.tile(&elim);
+    let x = tile.home_positions(&state.y);
+    tile.update_contacts(&x, problem.options.contact_margin * p.radius)?;
+    let ev = tile.evaluate(&state.frames, &state.y, Want::Gradient, &Terms::ALL)?;
+    let g = ev.gradient.expect("asked for");
+    let res = tile.offset_resultants(&state.frames, &state.y, &Terms::ALL)?;
+    let mut out = [None; 5];
+    for (j, slot) in out.iter_mut().enumerate() {
+        let skip = match state.family {
+            Family::BendY => j == 3,
+            Family::BendX => j == 4,
+        };
+        if skip {
+            continue;
+        }
+        let z: [Dual64; 5] =
+            std::array::from_fn(|k| Dual64::new(state.strain.0[k], if k == j { 1.0 } else { 0.0 }));
+        let map = SurfaceMap::new(&z, state.family);
+        let mut d = 0.0;
+        // home copies: g_x · ∂x_v/∂z with g_x = R_v g_ũ
+        for v in 0..n {
+            let u = local(&state.y, v).map(Dual64::from);
+            let xi = p.positions[v];
+            let xd = map.point([xi.x, xi.y], xi.z, &[u.x, u.y, u.z]);
+            let gx = elim.dofs.rotation[v] * Vector3::new(g[3 * v], g[3 * v + 1], g[3 * v + 2]);
+            d += (0..3).map(|c| gx[c] * xd[c].eps).sum::<f64>();
+        }
+        // tile transforms: δx = ω × x + v_o
+        for (o, f, m) in &res {
+            let delta = [o[0] as f64 * p.periods[0], o[1] as f64 * p.periods[1]];
+            let (phi, r) = map.frame(delta);
+            let rot = Matrix3::from_fn(|a, b| r[a][b].re);
+            let drot = Matrix3::from_fn(|a, b| r[a][b].eps);
+            let w = drot * rot.transpose();
+            let omega = Vector3::new(w[(2, 1)], w[(0, 2)], w[(1, 0)]);
+            let t = Vector3::from_fn(|a, _| phi[a].re);
+            let dt = Vector3::from_fn(|a, _| phi[a].eps);
+            let vo = dt - omega.cross(&t);
+            d += omega.dot(m) + vo.dot(f);
+        }
+        *slot = Some(d);
+    }
+    Ok(out)
+}
+
+/// The homogenized stress ∂Ψ̄/∂z (J/m² per unit strain) at an equilibrium. At zero curvature both bending
+/// components are given (the Π₀₀ one through the `BendX` family, which at zero curvature is the plane turned
+/// in-plane); under bending along one axis the other component is `None` (not a supported strain direction).
+pub fn strain_derivatives(
+    problem: &MicroProblem,
+    state: &MicroState,
+) -> Result<[Option<f64>; 5], MicroError> {
+    let area = problem.pattern.periods[0] * problem.pattern.periods[1];
+    let mut d = energy_strain_gradient(problem, state)?;
+    if state.family == Family::BendY && state.strain.0[4] == 0.0 {
+        let mut other = state.clone();
+        problem.switch_family(&mut other, Family::BendX);
+        d[3] = energy_strain_gradient(problem, &other)?[3];
+    }
+    Ok(d.map(|v| v.map(|v| v / area)))
+}
+
+/// ∂Ψ̄/∂(Y, G, γ, k_c, r) (J/m² per unit parameter) at a converged equilibrium.
+pub fn parameter_derivatives(
+    problem: &MicroProblem,
+    sol: &Solution,
+) -> Result<[f64; 5], MicroError> {
+    sol.psi().map_err(|e| {
+        MicroError::Linear(super::linear::FactorError::Other(format!(
+            "parameter derivatives need an equilibrium: {e}"
+        )))
+    })?;
+    let p = &problem.pattern;
+    let state = &sol.state;
+    let m = &problem.material;
+    let elim = Elimination::in_family(p, &state.strain, state.family);
+    let mut unit = m.clone();
+    unit.young = 1.0;
+    unit.shear = 1.0;
+    unit.bend_twist_factor = 1.0;
+    unit.contact_stiffness = 1.0;
+    let mut tile = Tile::new(p, &unit);
+    elim.apply_to(&mut tile);
+    let x = tile.home_positions(&state.y);
+    tile.update_contacts(&x, problem.options.contact_margin * p.radius)?;
+    let e1 = tile
+        .evaluate(&state.frames, &state.y, Want::Value, &Terms::ALL)?
+        .parts;
+    // radius: the contact kernel's own derivative
+    let kernel = PairKernel::new(m.contact_stiffness, p.radius, m.contact_quadrature)?;
+    let y = &state.y;
+    let mut dc_dr = 0.0;
+    for pair in &tile.contacts {
+        let pts = pair.points(&tile).map(|(v, o)| tile.position(y, v, o));
+        dc_dr += kernel.radius_derivative(
+            &pts,
+            p.edges[pair.a].rest_length,
+            p.edges[pair.b].rest_length,
+        )?;
+    }
+    let e = &sol.energy;
+    let (yg, g, ga, r) = (m.young, m.shear, m.bend_twist_factor, p.radius);
+    let area = sol.area;
+    Ok([
+        (e1.stretch + ga * e1.bend) / area,
+        ga * e1.twist / area,
+        (yg * e1.bend + g * e1.twist) / area,
+        e1.contact / area,
+        (2.0 * e.stretch / r + 4.0 * (e.bend + e.twist) / r + dc_dr) / area,
+    ])
+}

@@ -1,0 +1,17 @@
+//! Micro scale: homogenization of one periodic tile (`../shared/design/03-homogenization.md`, Algorithms C1–C3).
+//!
+//! Data flow: a macro strain ([`strain`]) selects a closed-form surface map ([`surface`]); the kinematics
+//! ([`elimination`]) place every vertex copy affinely in the unknowns; the Newton solver ([`solver`]) with its
+//! constrained linear system ([`linear`]) finds the equilibrium; [`envelope`] turns it into Ψ̄ and its
+//! derivatives.
+
+pub mod elimination;
+pub mod envelope;
+pub mod linear;
+pub mod solver;
+pub mod strain;
+pub mod surface;
+
+pub use elimination::Elimination;
+pub use solver::{MicroError, MicroProblem, MicroState, Solution, SolverOptions, Status};
+pub use strain::{Family, MacroStrain, StrainError};

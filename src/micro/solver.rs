@@ -1,0 +1,593 @@
+//! The micro-scale Newton solver (Algorithms C2, C3; `03-homogenization.md`, sections 2–4).
+//!
+//! A [`MicroProblem`] holds one pattern (its reference state), the yarn material and the solver options; its
+//! [`solve`](MicroProblem::solve) finds the yarn equilibrium at a macro strain, cold from the reference state or
+//! warm from a neighbouring solution. Each Newton step:
+//! 1. evaluates E, the reduced gradient and Hessian at y with the frames stored at y (exact Hessian);
+//! 2. tests convergence on ‖g‖_∞ ≤ tol·k_s and on the Newton decrement;
+//! 3. solves the KKT system of the null-space constraints with the unit scaling (r θ as the angular unknown),
+//!    growing μ ×10 while H + μI is not positive definite and shrinking it after successful steps;
+//! 4. limits the largest vertex displacement to step_factor · r · λ_min(Ī);
+//! 5. backtracks y₀ + 0.1ⁱ δy, i = 0 … 10, transporting the stored frames to each trial (the stored frames are
+//!    only replaced when a trial is accepted), refreshing the contact candidates when vertices have moved by more
+//!    than half the broad-phase margin, and accepts the first lower energy.
+//!
+//! Every result carries its [`Status`]; [`Solution::psi`] refuses a non-converged one.
+
+use super::elimination::Elimination;
+use super::linear::{FactorError, KktSolver};
+use super::strain::{Family, MacroStrain, StrainError};
+use crate::contact::ContactError;
+use crate::pattern::Pattern;
+use crate::rod::{RodState, RodTopology, YarnMaterial};
+use crate::tile::{EnergyParts, Terms, Tile, Want};
+use nalgebra::{Matrix3, Vector3};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::time::Instant;
+
+/// Solver settings (`03-homogenization.md`, section 4; defaults from there).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverOptions {
+    /// Dimensionless force tolerance: converged when ‖g‖_∞ ≤ tolerance · k_s.
+    pub tolerance: f64,
+    /// Newton step limit.
+    pub max_steps: usize,
+    /// Wall-time limit per solve (seconds), none by default.
+    pub time_limit: Option<f64>,
+    /// Displacement limit factor: d_max = step_factor · r · λ_min(Ī).
+    pub step_factor: f64,
+    /// Constrain each yarn's slide along itself (the original allowed switching it off).
+    pub slide_constraints: bool,
+    /// Broad-phase margin in units of r.
+    pub contact_margin: f64,
+}
+
+impl Default for SolverOptions {
+    fn default() -> Self {
+        SolverOptions {
+            tolerance: 1e-8,
+            max_steps: 2000,
+            time_limit: None,
+            step_factor: 1.0,
+            slide_constraints: true,
+            contact_margin: crate::tile::contact::DEFAULT_MARGIN,
+        }
+    }
+}
+
+/// How a solve ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Status {
+    /// The force or Newton-decrement test passed.
+    Converged,
+    /// No trial step lowered the energy while the gradient was above round-off.
+    Stalled,
+    /// The step limit was reached.
+    MaxSteps,
+    /// The time limit was reached.
+    TimeLimit,
+}
+
+impl fmt::Display for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{self:?}")
+    }
+}
+
+/// Errors that stop a solve before it runs or in the middle (bad input, overlapping yarns at the start).
+#[derive(Clone, Debug, PartialEq)]
+pub enum MicroError {
+    Strain(StrainError),
+    Contact(ContactError),
+    Linear(FactorError),
+}
+
+impl fmt::Display for MicroError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            MicroError::Strain(e) => write!(f, "{e}"),
+            MicroError::Contact(e) => write!(f, "contact: {e}"),
+            MicroError::Linear(e) => write!(f, "linear solve: {e:?}"),
+        }
+    }
+}
+
+impl std::error::Error for MicroError {}
+
+impl From<StrainError> for MicroError {
+    fn from(e: StrainError) -> Self {
+        MicroError::Strain(e)
+    }
+}
+
+impl From<ContactError> for MicroError {
+    fn from(e: ContactError) -> Self {
+        MicroError::Contact(e)
+    }
+}
+
+/// A yarn state at a macro strain: the unknowns y = (ũ, θ) in the tile's dof layout and the stored frames
+/// (world coordinates) at that state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MicroState {
+    pub strain: MacroStrain,
+    pub family: Family,
+    pub y: Vec<f64>,
+    pub frames: RodState,
+}
+
+/// Where the wall time of a solve went (seconds).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Timings {
+    /// Energy, gradient and Hessian assembly at the iterates.
+    pub assembly: f64,
+    /// Broad-phase contact updates.
+    pub contact: f64,
+    /// Factorisation and KKT solves.
+    pub factorization: f64,
+    /// Trial evaluations of the line search.
+    pub line_search: f64,
+    /// Moving the start state to the requested strain.
+    pub start: f64,
+}
+
+/// The outcome of one solve.
+#[derive(Clone, Debug)]
+pub struct Solution {
+    pub state: MicroState,
+    pub status: Status,
+    /// Newton steps taken.
+    pub steps: usize,
+    /// Energy parts at the final state (J, one tile).
+    pub energy: EnergyParts,
+    /// Final ‖g‖_∞ of the scaled reduced gradient projected on the constraint space (N).
+    pub gradient_norm: f64,
+    /// Wall time (s).
+    pub time: f64,
+    pub timings: Timings,
+    /// The reference area p₁ p₂ (m²).
+    pub area: f64,
+    /// The largest regularisation μ used (N/m).
+    pub max_mu: f64,
+}
+
+/// Asking for Ψ̄ of a non-converged solve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NotConverged {
+    pub status: Status,
+    pub steps: usize,
+    pub gradient_norm: f64,
+}
+
+impl fmt::Display for NotConverged {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "the micro solve did not converge ({} after {} steps, ‖g‖∞ = {:.3e} N)",
+            self.status, self.steps, self.gradient_norm
+        )
+    }
+}
+
+impl std::error::Error for NotConverged {}
+
+impl Solution {
+    /// Ψ̄ = E / (p₁ p₂) (J/m²) of a converged solve; an error for any other status.
+    pub fn psi(&self) -> Result<f64, NotConverged> {
+        if self.status == Status::Converged {
+            Ok(self.energy.total() / self.area)
+        } else {
+            Err(NotConverged {
+                status: self.status,
+                steps: self.steps,
+                gradient_norm: self.gradient_norm,
+            })
+        }
+    }
+}
+
+/// One pattern with its material and options, ready to solve at any strain.
+pub struct MicroProblem {
+    pub pattern: Pattern,
+    pub material: YarnMaterial,
+    pub options: SolverOptions,
+    topology: RodTopology,
+    /// Constraint rows A (length 4n each; zero on the angles), normalised.
+    constraints: Vec<Vec<f64>>,
+}
+
+impl MicroProblem {
+    /// The problem for `pattern` with `material` (its radius replaced by the pattern's).
+    pub fn new(pattern: Pattern, material: &YarnMaterial, options: SolverOptions) -> Self {
+        let mut material = material.clone();
+        material.radius = pattern.radius;
+        let topology = RodTopology::new(&pattern);
+        let constraints = null_space_rows(&pattern, options.slide_constraints);
+        MicroProblem {
+            pattern,
+            material,
+            options,
+            topology,
+            constraints,
+        }
+    }
+
+    /// The null-space constraint rows A (`03-homogenization.md`, section 3).
+    pub fn constraints(&self) -> &[Vec<f64>] {
+        &self.constraints
+    }
+
+    /// Euclidean projection of a (scaled) gradient on the null space of A: g − Aᵀ (A Aᵀ)⁻¹ A g.
+    pub fn project(&self, g: &[f64]) -> Vec<f64> {
+        let a = &self.constraints;
+        let m = a.len();
+        let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
+        let gram = nalgebra::DMatrix::from_fn(m, m, |i, j| dot(&a[i], &a[j]));
+        let ag = nalgebra::DVector::from_fn(m, |i, _| dot(&a[i], g));
+        let Some(c) = gram.cholesky() else {
+            return g.to_vec();
+        };
+        let lambda = c.solve(&ag);
+        let mut out = g.to_vec();
+        for (k, row) in a.iter().enumerate() {
+            for (o, r) in out.iter_mut().zip(row) {
+                *o -= lambda[k] * r;
+            }
+        }
+        out
+    }
+
+    /// The reference state: zero strain, ũ = 0, the pattern's angles and frames.
+    pub fn reference_state(&self) -> MicroState {
+        let n = self.pattern.len();
+        let mut y = vec![0.0; 3 * n];
+        y.extend_from_slice(&self.pattern.theta);
+        MicroState {
+            strain: MacroStrain::ZERO,
+            family: Family::BendY,
+            y,
+            frames: RodState::from_pattern(&self.pattern),
+        }
+    }
+
+    /// A tile for `elim` (contacts not yet found).
+    pub fn tile(&self, elim: &Elimination) -> Tile<'_> {
+        let mut t = Tile::new(&self.pattern, &self.material);
+        elim.apply_to(&mut t);
+        t
+    }
+
+    /// Move a state to another strain at fixed ũ and θ: in steps small enough for the frame transport and the
+    /// reference-twist continuation, switching between the `BendY` and `BendX` families at zero curvature.
+    pub fn move_to(&self, state: &mut MicroState, target: &MacroStrain) -> Result<(), StrainError> {
+        let family = target.validate()?;
+        if family != state.family {
+            // leave the current family at zero curvature, switch, continue
+            let mut flat = state.strain;
+            flat.0[3] = 0.0;
+            flat.0[4] = 0.0;
+            self.move_within(state, &flat);
+            self.switch_family(state, family);
+        }
+        self.move_within(state, target);
+        Ok(())
+    }
+
+    fn move_within(&self, state: &mut MicroState, target: &MacroStrain) {
+        let from = state.strain;
+        let pmax = self.pattern.periods[0].max(self.pattern.periods[1]);
+        let dz = (0..3)
+            .map(|k| (target.0[k] - from.0[k]).abs())
+            .fold(0.0, f64::max);
+        let dk = (target.0[3] - from.0[3])
+            .abs()
+            .max((target.0[4] - from.0[4]).abs());
+        let steps = ((dz / 0.05).max(dk * 2.0 * pmax / 0.25).ceil() as usize).max(1);
+        if from == *target {
+            return;
+        }
+        let n = self.pattern.len();
+        let mut old = Elimination::in_family(&self.pattern, &from, state.family);
+        for s in 1..=steps {
+            let t = s as f64 / steps as f64;
+            let z = MacroStrain(std::array::from_fn(|k| {
+                if s == steps {
+                    target.0[k]
+                } else {
+                    from.0[k] + t * (target.0[k] - from.0[k])
+                }
+            }));
+            let new = Elimination::in_family(&self.pattern, &z, state.family);
+            let positions: Vec<Vector3<f64>> = (0..n)
+                .map(|v| new.position(v, [0, 0], &local(&state.y, v)))
+                .collect();
+            let theta = state.y[3 * n..].to_vec();
+            state.frames.advance_between(
+                &self.pattern,
+                &self.topology,
+                positions,
+                theta,
+                &old.transforms,
+                &new.transforms,
+            );
+            old = new;
+        }
+        state.strain = *target;
+    }
+
+    /// Switch between `BendY` and `BendX` at zero curvature: a rotation Q about e₃ with Q F₂ = G₂ maps the plane
+    /// of one family onto the other; positions, frames and local displacements turn with it.
+    pub fn switch_family(&self, state: &mut MicroState, family: Family) {
+        if family == state.family {
+            return;
+        }
+        let c = state.strain.0[1];
+        let s = (1.0 - c * c).sqrt();
+        // BendY → BendX: Q e₁ = (√(1−c²), c, 0)
+        let mut q = Matrix3::new(s, -c, 0.0, c, s, 0.0, 0.0, 0.0, 1.0);
+        if family == Family::BendY {
+            q = q.transpose();
+        }
+        let f = &mut state.frames;
+        for x in f.positions.iter_mut() {
+            *x = q * *x;
+        }
+        for t in f.tangents.iter_mut() {
+            *t = q * *t;
+        }
+        for d in f.directors.iter_mut() {
+            *d = q * *d;
+        }
+        let n = self.pattern.len();
+        for v in 0..n {
+            let u = q * local(&state.y, v);
+            state.y[3 * v..3 * v + 3].copy_from_slice(u.as_slice());
+        }
+        state.family = family;
+    }
+
+    /// Solve at `strain`, starting from `start` (the reference state when `None`).
+    pub fn solve(
+        &self,
+        strain: &MacroStrain,
+        start: Option<&MicroState>,
+    ) -> Result<Solution, MicroError> {
+        let t0 = Instant::now();
+        strain.validate()?;
+        let mut state = match start {
+            Some(s) => s.clone(),
+            None => self.reference_state(),
+        };
+        self.move_to(&mut state, strain)?;
+        let start_time = t0.elapsed().as_secs_f64();
+        let mut sol = self.newton(state, t0)?;
+        sol.timings.start = start_time;
+        Ok(sol)
+    }
+
+    /// Newton iterations from a state already at its strain.
+    fn newton(&self, mut state: MicroState, t0: Instant) -> Result<Solution, MicroError> {
+        let opts = &self.options;
+        let n = self.pattern.len();
+        let nd = 4 * n;
+        let r = self.pattern.radius;
+        let ks = self.material.stretch_stiffness();
+        let elim = Elimination::in_family(&self.pattern, &state.strain, state.family);
+        let mut tile = self.tile(&elim);
+        let margin = opts.contact_margin * r;
+        let mut timings = Timings::default();
+
+        let tc = Instant::now();
+        let mut contact_at = tile.home_positions(&state.y);
+        tile.update_contacts(&contact_at, margin)?;
+        timings.contact += tc.elapsed().as_secs_f64();
+
+        // unit scaling M: the angular unknown is r θ
+        let scale = |i: usize| if i < 3 * n { 1.0 } else { 1.0 / r };
+        let d_max = opts.step_factor * r * state.strain.min_stretch_eigenvalue();
+        let mut kkt = KktSolver::default();
+        let mut mu = 0.0;
+        let mut max_mu: f64 = 0.0;
+        let mut steps = 0;
+        let area = self.pattern.periods[0] * self.pattern.periods[1];
+
+        loop {
+            let ta = Instant::now();
+            let ev = tile.evaluate(&state.frames, &state.y, Want::Hessian, &Terms::ALL)?;
+            timings.assembly += ta.elapsed().as_secs_f64();
+            let energy = ev.value();
+            let g: Vec<f64> = ev
+                .gradient
+                .as_ref()
+                .expect("asked for")
+                .iter()
+                .enumerate()
+                .map(|(i, v)| v * scale(i))
+                .collect();
+            // the force test uses the gradient projected on the constraint space (the constrained equilibrium
+            // keeps a residual g = −Aᵀλ along the rows that are not exact symmetries, e.g. the yarn slides)
+            let gnorm = self.project(&g).iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let finish =
+                |state: MicroState, status: Status, steps: usize, timings: Timings, max_mu: f64| {
+                    Solution {
+                        state,
+                        status,
+                        steps,
+                        energy: ev.parts,
+                        gradient_norm: gnorm,
+                        time: t0.elapsed().as_secs_f64(),
+                        timings,
+                        area,
+                        max_mu,
+                    }
+                };
+            if gnorm <= opts.tolerance * ks {
+                return Ok(finish(state, Status::Converged, steps, timings, max_mu));
+            }
+            if steps >= opts.max_steps {
+                return Ok(finish(state, Status::MaxSteps, steps, timings, max_mu));
+            }
+            if let Some(limit) = opts.time_limit {
+                if t0.elapsed().as_secs_f64() > limit {
+                    return Ok(finish(state, Status::TimeLimit, steps, timings, max_mu));
+                }
+            }
+
+            // KKT step, growing μ until H + μI factorises
+            let tf = Instant::now();
+            let lower: Vec<(usize, usize, f64)> = ev
+                .hessian
+                .as_ref()
+                .expect("asked for")
+                .iter()
+                .filter(|&&(i, j, _)| i >= j)
+                .map(|&(i, j, v)| (i, j, v * scale(i) * scale(j)))
+                .collect();
+            let diag_max = lower
+                .iter()
+                .filter(|t| t.0 == t.1)
+                .fold(0.0f64, |m, t| m.max(t.2.abs()))
+                .max(ks / r);
+            let mu_floor = 1e-10 * diag_max;
+            let mut delta = None;
+            for _ in 0..40 {
+                match kkt.solve(nd, &lower, mu, &g, &self.constraints) {
+                    Ok(d) => {
+                        delta = Some(d);
+                        break;
+                    }
+                    Err(FactorError::NotPositiveDefinite) => {
+                        mu = (10.0 * mu).max(mu_floor);
+                    }
+                    Err(e) => return Err(MicroError::Linear(e)),
+                }
+            }
+            timings.factorization += tf.elapsed().as_secs_f64();
+            max_mu = max_mu.max(mu);
+            let Some(mut delta) = delta else {
+                return Ok(finish(state, Status::Stalled, steps, timings, max_mu));
+            };
+            let decrement: f64 = g.iter().zip(&delta).map(|(a, b)| a * b).sum();
+            if decrement.abs() <= 1e-14 * (energy.abs() + ks * r) {
+                return Ok(finish(state, Status::Converged, steps, timings, max_mu));
+            }
+            // back to tile dofs (θ = y_θ / r), then the displacement limit
+            for (i, d) in delta.iter_mut().enumerate() {
+                *d *= scale(i);
+            }
+            let dmax_now = (0..n)
+                .map(|v| Vector3::new(delta[3 * v], delta[3 * v + 1], delta[3 * v + 2]).norm())
+                .fold(0.0, f64::max);
+            if dmax_now > d_max {
+                let f = d_max / dmax_now;
+                delta.iter_mut().for_each(|d| *d *= f);
+            }
+
+            // backtracking line search on the energy
+            let tl = Instant::now();
+            let mut accepted = false;
+            let mut step = 1.0;
+            for _ in 0..=10 {
+                let trial: Vec<f64> = state
+                    .y
+                    .iter()
+                    .zip(&delta)
+                    .map(|(a, b)| a + step * b)
+                    .collect();
+                let positions = tile.home_positions(&trial);
+                let moved = positions
+                    .iter()
+                    .zip(&contact_at)
+                    .map(|(a, b)| (a - b).norm())
+                    .fold(0.0, f64::max);
+                if moved > 0.5 * margin {
+                    let tc = Instant::now();
+                    if tile.update_contacts(&positions, margin).is_ok() {
+                        contact_at = positions.clone();
+                    }
+                    timings.contact += tc.elapsed().as_secs_f64();
+                }
+                let e = tile
+                    .evaluate(&state.frames, &trial, Want::Value, &Terms::ALL)
+                    .map(|r| r.value())
+                    .unwrap_or(f64::INFINITY);
+                if e < energy {
+                    let theta = trial[3 * n..].to_vec();
+                    state.frames.advance(
+                        &self.pattern,
+                        &self.topology,
+                        positions,
+                        theta,
+                        &tile.placement,
+                    );
+                    state.y = trial;
+                    accepted = true;
+                    break;
+                }
+                step *= 0.1;
+            }
+            timings.line_search += tl.elapsed().as_secs_f64();
+            steps += 1;
+            if !accepted {
+                // no lower energy: converged only at round-off level
+                let status = if decrement.abs() <= 1e-11 * (energy.abs() + ks * r) {
+                    Status::Converged
+                } else {
+                    Status::Stalled
+                };
+                return Ok(finish(state, status, steps, timings, max_mu));
+            }
+            mu = if mu / 10.0 < mu_floor { 0.0 } else { mu / 10.0 };
+        }
+    }
+}
+
+/// ũ_v from the dof vector.
+pub fn local(y: &[f64], v: usize) -> Vector3<f64> {
+    Vector3::new(y[3 * v], y[3 * v + 1], y[3 * v + 2])
+}
+
+/// The null-space constraint rows (`03-homogenization.md`, section 3), each normalised to unit length: the
+/// Voronoi-weighted mean displacement (3 rows) and, optionally, one no-slide row per yarn Σ wᵢ t̄ᵢ·ũᵢ with t̄ᵢ
+/// the reference unit tangent at vertex i (mean of its two edges' directions).
+pub fn null_space_rows(p: &Pattern, slide: bool) -> Vec<Vec<f64>> {
+    let n = p.len();
+    let w = p.voronoi_lengths();
+    let mut rows = Vec::new();
+    for c in 0..3 {
+        let mut row = vec![0.0; 4 * n];
+        for v in 0..n {
+            row[3 * v + c] = w[v];
+        }
+        rows.push(row);
+    }
+    if slide {
+        let prev = p.prev();
+        for yarn in p.yarns() {
+            let mut row = vec![0.0; 4 * n];
+            for &v in &yarn {
+                let t =
+                    (p.edge_vector(prev[v]).normalize() + p.edge_vector(v).normalize()).normalize();
+                for c in 0..3 {
+                    row[3 * v + c] = w[v] * t[c];
+                }
+            }
+            rows.push(row);
+        }
+    }
+    for row in rows.iter_mut() {
+        let norm = row.iter().map(|v| v * v).sum::<f64>().sqrt();
+        row.iter_mut().for_each(|v| *v /= norm);
+    }
+    rows
+}
+
+/// The world positions of a state's home vertices at its strain.
+pub fn world_positions(p: &Pattern, state: &MicroState) -> Vec<Vector3<f64>> {
+    let e = Elimination::in_family(p, &state.strain, state.family);
+    (0..p.len())
+        .map(|v| e.position(v, [0, 0], &local(&state.y, v)))
+        .collect()
+}
