@@ -125,6 +125,9 @@ enum Command {
         /// one JSON object per strain
         #[arg(long)]
         json: bool,
+        /// print one line per Newton step to stderr
+        #[arg(long)]
+        trace: bool,
     },
     /// Ψ̄ at one strain with its derivatives with respect to the strain and to the yarn parameters (envelope
     /// theorem).
@@ -198,8 +201,10 @@ fn main() -> ExitCode {
             no_slide_constraints,
             obj,
             json,
+            trace,
         } => {
             let options = hylc::micro::SolverOptions {
+                trace,
                 tolerance,
                 max_steps,
                 step_factor,

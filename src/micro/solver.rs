@@ -42,6 +42,8 @@ pub struct SolverOptions {
     pub slide_constraints: bool,
     /// Broad-phase margin in units of r.
     pub contact_margin: f64,
+    /// Print one line per Newton step to stderr (energy, ‖g‖∞, decrement, μ, step length).
+    pub trace: bool,
 }
 
 impl Default for SolverOptions {
@@ -53,6 +55,7 @@ impl Default for SolverOptions {
             step_factor: 1.0,
             slide_constraints: true,
             contact_margin: crate::tile::contact::DEFAULT_MARGIN,
+            trace: false,
         }
     }
 }
@@ -388,7 +391,7 @@ impl MicroProblem {
         let scale = |i: usize| if i < 3 * n { 1.0 } else { 1.0 / r };
         let d_max = opts.step_factor * r * state.strain.min_stretch_eigenvalue();
         let mut kkt = KktSolver::default();
-        let mut mu = 0.0;
+        let mut mu: f64 = 0.0;
         let mut max_mu: f64 = 0.0;
         let mut steps = 0;
         let area = self.pattern.periods[0] * self.pattern.periods[1];
@@ -450,16 +453,21 @@ impl MicroProblem {
                 .filter(|t| t.0 == t.1)
                 .fold(0.0f64, |m, t| m.max(t.2.abs()))
                 .max(ks / r);
+            // The tile's rigid motions make H exactly singular: a factorisation at μ = 0 "succeeds" with pivots at
+            // round-off level and returns noise. μ therefore never drops below 1e-10 of the largest diagonal
+            // entry (the constraints remove those modes from the step; the shift changes the step by O(1e-10)
+            // relative in the others). A step that is not a descent direction counts as a failed factorisation.
             let mu_floor = 1e-10 * diag_max;
+            mu = mu.max(mu_floor);
             let mut delta = None;
             for _ in 0..40 {
                 match kkt.solve(nd, &lower, mu, &g, &self.constraints) {
-                    Ok(d) => {
+                    Ok(d) if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 => {
                         delta = Some(d);
                         break;
                     }
-                    Err(FactorError::NotPositiveDefinite) => {
-                        mu = (10.0 * mu).max(mu_floor);
+                    Ok(_) | Err(FactorError::NotPositiveDefinite) => {
+                        mu *= 10.0;
                     }
                     Err(e) => return Err(MicroError::Linear(e)),
                 }
@@ -529,6 +537,14 @@ impl MicroProblem {
                 step *= 0.1;
             }
             timings.line_search += tl.elapsed().as_secs_f64();
+            if opts.trace {
+                eprintln!(
+                    "step {steps}: E {energy:.15e} J, |g|inf {gnorm:.3e} N, g.d {decrement:.3e} J, mu {mu:.2e}, \
+                     |d|max {:.3e} m, accepted {}",
+                    dmax_now.min(d_max),
+                    if accepted { format!("at {step:.0e}") } else { "none".into() }
+                );
+            }
             steps += 1;
             if !accepted {
                 // no lower energy: converged only at round-off level
@@ -539,7 +555,7 @@ impl MicroProblem {
                 };
                 return Ok(finish(state, status, steps, timings, max_mu));
             }
-            mu = if mu / 10.0 < mu_floor { 0.0 } else { mu / 10.0 };
+            mu = (mu / 10.0).max(mu_floor);
         }
     }
 }
