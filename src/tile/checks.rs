@@ -113,42 +113,11 @@ impl Differentiable for TileCheck {
     fn reference<D: Real>(&self, y: &[D]) -> D {
         let tile = self.tile();
         let n = self.pattern.len();
-        let m = &self.material;
         let pos = |v: usize, o: [i32; 2]| -> [D; 3] {
             let s = self.pattern.shift(o);
             [0, 1, 2].map(|c| y[3 * v + c].clone() + s[c])
         };
-        let mut e = D::from(0.0);
-        for (i, edge) in self.pattern.edges.iter().enumerate() {
-            let mut x: Vec<D> = pos(i, [0, 0]).to_vec();
-            x.extend(pos(edge.end, edge.offset));
-            e += stretch_reference(&x, edge.rest_length, m.stretch_stiffness());
-        }
-        for (i, s) in tile.topology.stencils.iter().enumerate() {
-            let mut x: Vec<D> = Vec::with_capacity(11);
-            for k in 0..3 {
-                x.extend(pos(s.vertices[k], s.offsets[k]));
-            }
-            x.push(y[3 * n + s.edges[0]].clone());
-            x.push(y[3 * n + s.edges[1]].clone());
-            let (_, _, fr) = self.frames.stencil(s, &tile.placement);
-            e += bend_twist_reference(&x, &fr, &tile.bend_params(i, &Terms::ALL));
-        }
-        for pair in &self.contacts {
-            let mut x: Vec<D> = Vec::with_capacity(12);
-            for (v, o) in pair.points(&tile) {
-                x.extend(pos(v, o));
-            }
-            e += pair_energy_reference(
-                &x,
-                self.pattern.edges[pair.a].rest_length,
-                self.pattern.edges[pair.b].rest_length,
-                m.contact_stiffness,
-                m.radius,
-                &self.rule,
-            );
-        }
-        e
+        reference_energy(&tile, &self.frames, &self.rule, &y[3 * n..], &pos)
     }
     fn fast(&self, y: &[f64]) -> Vgh {
         let n = self.dim();
@@ -194,6 +163,50 @@ impl Differentiable for TileCheck {
         }
         y
     }
+}
+
+/// The plain sum of the stencils' reference twins over a tile's stencils and contact pairs, with the world
+/// position of every copy given by `pos(vertex, offset)` and the angles `theta` (shared with the micro rows).
+pub(crate) fn reference_energy<D: Real>(
+    tile: &Tile,
+    frames: &RodState,
+    rule: &GaussLegendre,
+    theta: &[D],
+    pos: &dyn Fn(usize, [i32; 2]) -> [D; 3],
+) -> D {
+    let p = tile.pattern;
+    let m = &tile.material;
+    let mut e = D::from(0.0);
+    for (i, edge) in p.edges.iter().enumerate() {
+        let mut x: Vec<D> = pos(i, [0, 0]).to_vec();
+        x.extend(pos(edge.end, edge.offset));
+        e += stretch_reference(&x, edge.rest_length, m.stretch_stiffness());
+    }
+    for (i, s) in tile.topology.stencils.iter().enumerate() {
+        let mut x: Vec<D> = Vec::with_capacity(11);
+        for k in 0..3 {
+            x.extend(pos(s.vertices[k], s.offsets[k]));
+        }
+        x.push(theta[s.edges[0]].clone());
+        x.push(theta[s.edges[1]].clone());
+        let (_, _, fr) = frames.stencil(s, &tile.placement);
+        e += bend_twist_reference(&x, &fr, &tile.bend_params(i, &Terms::ALL));
+    }
+    for pair in &tile.contacts {
+        let mut x: Vec<D> = Vec::with_capacity(12);
+        for (v, o) in pair.points(tile) {
+            x.extend(pos(v, o));
+        }
+        e += pair_energy_reference(
+            &x,
+            p.edges[pair.a].rest_length,
+            p.edges[pair.b].rest_length,
+            m.contact_stiffness,
+            tile.contact_radius,
+            rule,
+        );
+    }
+    e
 }
 
 /// The whole-tile rows: built from the embedded generated patterns (no external data needed).

@@ -8,7 +8,7 @@
 //! value, gradient and Hessian are those of one smooth function of the dofs (what the derivative harness checks).
 
 pub mod calibration;
-mod checks;
+pub(crate) mod checks;
 pub mod contact;
 
 pub use checks::diff_checks;

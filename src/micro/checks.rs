@@ -1,0 +1,209 @@
+//! Harness rows for the reduced micro energy E(C̃y + d̃) (`06-verification.md`, section 1): every unknown of a
+//! small generated pattern at once, under an in-plane strain and under bending along each axis.
+//!
+//! Reference: the explicit sparse elimination map C̃, d̃ ([`Elimination::matrix`]) applied to the generic unknowns,
+//! then the plain sum of the stencils' reference twins; so the row checks the solver's stencil-by-stencil
+//! pull-back through the 3×3 rotation blocks against the literal definition. Samples: the state moved to the
+//! strain (ũ = 0), and perturbations of 0.05 r / 0.1 rad and 0.2 r / 0.3 rad (θ also shifted by ±2π). Scales
+//! as for the whole-tile row ([`crate::tile`]).
+
+use super::elimination::{stencil_copies, Elimination};
+use super::solver::{MicroProblem, MicroState, SolverOptions};
+use super::strain::MacroStrain;
+use crate::contact::GaussLegendre;
+use crate::diff::{Check, Differentiable, Real, Scales, Vgh};
+use crate::pattern::Pattern;
+use crate::rod::YarnMaterial;
+use crate::tile::checks::reference_energy;
+use crate::tile::{ContactPair, Terms, Tile, Want};
+use nalgebra::{DMatrix, DVector};
+use rand::Rng;
+use rand_chacha::ChaCha8Rng;
+use std::collections::HashMap;
+
+/// The reduced energy of one pattern at one strain as a function of all unknowns y = (ũ, θ).
+pub struct ReducedEnergyCheck {
+    name: String,
+    problem: MicroProblem,
+    state: MicroState,
+    elim: Elimination,
+    contacts: Vec<ContactPair>,
+    copies: HashMap<(usize, [i32; 2]), usize>,
+    /// C̃ as triplets and d̃.
+    c: Vec<(usize, usize, f64)>,
+    d: Vec<f64>,
+    rule: GaussLegendre,
+}
+
+impl ReducedEnergyCheck {
+    pub fn new(name: &str, pattern: Pattern, material: &YarnMaterial, strain: MacroStrain) -> Self {
+        let problem = MicroProblem::new(pattern, material, SolverOptions::default());
+        let mut state = problem.reference_state();
+        problem
+            .move_to(&mut state, &strain)
+            .expect("the harness strains are admissible");
+        let elim = Elimination::in_family(&problem.pattern, &state.strain, state.family);
+        let (contacts, list) = {
+            let mut tile = problem.tile(&elim);
+            let x = tile.home_positions(&state.y);
+            tile.update_contacts(&x, problem.options.contact_margin * problem.pattern.radius)
+                .expect("the harness pattern has finite positions");
+            let list = stencil_copies(&tile);
+            (tile.contacts.clone(), list)
+        };
+        let (c, d) = elim.matrix(&list, problem.pattern.len());
+        let copies = list.iter().enumerate().map(|(k, &key)| (key, k)).collect();
+        let rule = GaussLegendre::new(problem.material.contact_quadrature);
+        ReducedEnergyCheck {
+            name: name.to_string(),
+            problem,
+            state,
+            elim,
+            contacts,
+            copies,
+            c,
+            d,
+            rule,
+        }
+    }
+
+    fn tile(&self) -> Tile<'_> {
+        let mut t = self.problem.tile(&self.elim);
+        t.contacts = self.contacts.clone();
+        t
+    }
+}
+
+impl Differentiable for ReducedEnergyCheck {
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+    fn dim(&self) -> usize {
+        4 * self.problem.pattern.len()
+    }
+    fn cases(&self, requested: usize) -> usize {
+        requested.min(24)
+    }
+    fn scales(&self) -> Scales {
+        let p = &self.problem.pattern;
+        let n = p.len() as f64;
+        let l = p.edges.iter().map(|e| e.rest_length).sum::<f64>() / n;
+        let m = &self.problem.material;
+        let k = m.stretch_stiffness() * l
+            + (m.bend_stiffness() + m.twist_stiffness()) / l
+            + m.contact_stiffness * l * l;
+        Scales {
+            value: n * k,
+            gradient: n.sqrt() * k / l,
+            hessian: n.sqrt() * k / (l * l),
+        }
+    }
+    fn input_scale(&self, i: usize) -> f64 {
+        if i < 3 * self.problem.pattern.len() {
+            self.problem.pattern.radius
+        } else {
+            1.0
+        }
+    }
+    fn kink_distance_of(&self, x: &[f64], i: usize) -> f64 {
+        if i >= 3 * self.problem.pattern.len() {
+            return f64::INFINITY;
+        }
+        let tile = self.tile();
+        let two_r = 2.0 * self.problem.pattern.radius;
+        let mut gap = f64::INFINITY;
+        for pair in &self.contacts {
+            let p = pair.points(&tile).map(|(v, o)| tile.position(x, v, o));
+            for &s in self.rule.nodes() {
+                for &t in self.rule.nodes() {
+                    let d = (p[0] * (1.0 - s) + p[1] * s) - (p[2] * (1.0 - t) + p[3] * t);
+                    gap = gap.min((d.norm() - two_r).abs());
+                }
+            }
+        }
+        gap
+    }
+    fn reference<D: Real>(&self, y: &[D]) -> D {
+        let tile = self.tile();
+        let n = self.problem.pattern.len();
+        // q = C̃ y + d̃, literally
+        let mut q: Vec<D> = self.d.iter().map(|&v| D::from(v)).collect();
+        for &(r, c, v) in &self.c {
+            q[r] += y[c].clone() * v;
+        }
+        let k_theta = 3 * self.copies.len();
+        let pos = |v: usize, o: [i32; 2]| -> [D; 3] {
+            let k = self.copies[&(v, o)];
+            [0, 1, 2].map(|c| q[3 * k + c].clone())
+        };
+        reference_energy(&tile, &self.state.frames, &self.rule, &q[k_theta..k_theta + n], &pos)
+    }
+    fn fast(&self, y: &[f64]) -> Vgh {
+        let n = self.dim();
+        match self
+            .tile()
+            .evaluate(&self.state.frames, y, Want::Hessian, &Terms::ALL)
+        {
+            Ok(r) => Vgh {
+                value: r.value(),
+                hessian: r.dense_hessian(n).unwrap_or_else(|| DMatrix::zeros(n, n)),
+                gradient: r.gradient.unwrap_or_else(|| DVector::zeros(n)),
+            },
+            Err(_) => Vgh {
+                value: f64::NAN,
+                gradient: DVector::from_element(n, f64::NAN),
+                hessian: DMatrix::from_element(n, n, f64::NAN),
+            },
+        }
+    }
+    fn fast_value(&self, y: &[f64]) -> f64 {
+        self.tile()
+            .evaluate(&self.state.frames, y, Want::Value, &Terms::ALL)
+            .map(|r| r.value())
+            .unwrap_or(f64::NAN)
+    }
+    fn sample(&self, rng: &mut ChaCha8Rng, i: usize) -> Vec<f64> {
+        let mut y = self.state.y.clone();
+        let n = self.problem.pattern.len();
+        let r = self.problem.pattern.radius;
+        let (dx, dth, wind) = match i % 3 {
+            0 => (0.0, 0.0, false),
+            1 => (0.05 * r, 0.1, false),
+            _ => (0.2 * r, 0.3, true),
+        };
+        for v in y.iter_mut().take(3 * n) {
+            *v += rng.random_range(-dx..=dx);
+        }
+        for v in y.iter_mut().skip(3 * n) {
+            *v += rng.random_range(-dth..=dth);
+            if wind {
+                *v += 2.0 * std::f64::consts::PI * rng.random_range(-1..=1) as f64;
+            }
+        }
+        y
+    }
+}
+
+/// The reduced-energy rows on the embedded plain weave: in-plane, bending along ξ₁, bending along ξ₂.
+pub fn diff_checks() -> Vec<Box<dyn Check>> {
+    let m = YarnMaterial::default();
+    let strains = [
+        ("in-plane", MacroStrain::in_plane(0.1, 0.2, -0.05)),
+        ("bend-x", MacroStrain::new(0.05, 0.1, 0.0, 60.0, 0.0)),
+        ("bend-y", MacroStrain::new(-0.05, -0.1, 0.02, 0.0, -50.0)),
+    ];
+    crate::pattern::generate::harness_patterns()
+        .into_iter()
+        .flat_map(|(name, p)| {
+            let m = m.clone();
+            strains.iter().map(move |(label, z)| {
+                Box::new(ReducedEnergyCheck::new(
+                    &format!("micro E(Cy+d)[{name},{label}]"),
+                    p.clone(),
+                    &m,
+                    *z,
+                )) as Box<dyn Check>
+            })
+        })
+        .collect()
+}
