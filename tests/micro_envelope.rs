@@ -51,7 +51,10 @@ fn strain_derivatives_match_resolves() {
             let fd = (psi(&p, &zp, &sol.state) - psi(&p, &zm, &sol.state)) / (2.0 * h);
             let scale = psi0.abs() * if j < 3 { 1.0 } else { 0.01 };
             let e = rel(an, fd, scale);
-            assert!(e <= 1e-4, "{z} component {j}: envelope {an:e} vs re-solve FD {fd:e} (rel {e:.2e})");
+            assert!(
+                e <= 1e-4,
+                "{z} component {j}: envelope {an:e} vs re-solve FD {fd:e} (rel {e:.2e})"
+            );
         }
     }
 }
@@ -72,7 +75,15 @@ fn parameter_derivatives_match_resolves() {
             3 => m.contact_stiffness = v,
             _ => m.radius = v,
         };
-        let get = |m: &YarnMaterial| [m.young, m.shear, m.bend_twist_factor, m.contact_stiffness, p.pattern.radius][k];
+        let get = |m: &YarnMaterial| {
+            [
+                m.young,
+                m.shear,
+                m.bend_twist_factor,
+                m.contact_stiffness,
+                p.pattern.radius,
+            ][k]
+        };
         let v0 = get(&base);
         let h = 1e-4 * v0;
         let at = |v: f64| {
@@ -89,6 +100,10 @@ fn parameter_derivatives_match_resolves() {
         };
         let fd = (at(v0 + h) - at(v0 - h)) / (2.0 * h);
         let e = rel(d[k], fd, psi0.abs() / v0);
-        assert!(e <= 1e-4, "∂Ψ̄/∂{name}: envelope {:e} vs re-solve FD {fd:e} (rel {e:.2e})", d[k]);
+        assert!(
+            e <= 1e-4,
+            "∂Ψ̄/∂{name}: envelope {:e} vs re-solve FD {fd:e} (rel {e:.2e})",
+            d[k]
+        );
     }
 }

@@ -129,6 +129,25 @@ enum Command {
         #[arg(long)]
         trace: bool,
     },
+    /// Compute the reference state of a pattern (Algorithm C1: stress-free state, tension, zero-stress periods,
+    /// centring) and write it as `.pyp`.
+    Reference {
+        /// `.pyp` file or generated kind
+        pattern: String,
+        /// knitted or woven (selects the tension factors; inferred for generated kinds)
+        #[arg(long)]
+        construction: Option<String>,
+        /// skip the stress-free state and the tension (re-equilibrate a pattern that is already a reference
+        /// state, e.g. an original `.pyp` with this project's yarn model): zero-stress periods and centring only
+        #[arg(long)]
+        equilibrate_only: bool,
+        /// output `.pyp` file
+        #[arg(long)]
+        out: PathBuf,
+        /// write the report as JSON
+        #[arg(long)]
+        json: Option<PathBuf>,
+    },
     /// Ψ̄ at one strain with its derivatives with respect to the strain and to the yarn parameters (envelope
     /// theorem).
     Sensitivity {
@@ -219,6 +238,20 @@ fn main() -> ExitCode {
                 }
             })
         }
+        Command::Reference {
+            pattern,
+            construction,
+            equilibrate_only,
+            out,
+            json,
+        } => micro::reference(
+            &pattern,
+            construction.as_deref(),
+            equilibrate_only,
+            &out,
+            json.as_deref(),
+        )
+        .map(|_| ExitCode::SUCCESS),
         Command::Sensitivity { pattern, z } => {
             micro::sensitivity(&pattern, &z, Default::default()).map(|_| ExitCode::SUCCESS)
         }

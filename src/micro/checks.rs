@@ -136,7 +136,13 @@ impl Differentiable for ReducedEnergyCheck {
             let k = self.copies[&(v, o)];
             [0, 1, 2].map(|c| q[3 * k + c].clone())
         };
-        reference_energy(&tile, &self.state.frames, &self.rule, &q[k_theta..k_theta + n], &pos)
+        reference_energy(
+            &tile,
+            &self.state.frames,
+            &self.rule,
+            &q[k_theta..k_theta + n],
+            &pos,
+        )
     }
     fn fast(&self, y: &[f64]) -> Vgh {
         let n = self.dim();

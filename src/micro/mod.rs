@@ -9,6 +9,7 @@ mod checks;
 pub mod elimination;
 pub mod envelope;
 pub mod linear;
+pub mod reference;
 pub mod solver;
 pub mod strain;
 pub mod surface;

@@ -202,3 +202,71 @@ pub fn sensitivity(pattern: &str, z: &str, options: SolverOptions) -> Result<boo
     }
     Ok(true)
 }
+
+/// `hylc reference`: Algorithm C1 on a pattern, written as `.pyp`.
+pub fn reference(
+    pattern: &str,
+    construction: Option<&str>,
+    equilibrate_only: bool,
+    out: &Path,
+    json_out: Option<&Path>,
+) -> Result<bool, String> {
+    use hylc::micro::reference::{reference_state, Construction, ReferenceOptions};
+    let p = load_pattern(pattern)?;
+    let construction = match construction {
+        Some("knitted") | Some("knit") => Construction::Knitted,
+        Some("woven") | Some("weave") => Construction::Woven,
+        Some(other) => {
+            return Err(format!(
+                "--construction: expected knitted or woven, got {other:?}"
+            ))
+        }
+        None if equilibrate_only => Construction::Woven,
+        None if Path::new(pattern).exists() => {
+            return Err(format!(
+                "{pattern}: pass --construction knitted|woven (it selects the tension factors)"
+            ))
+        }
+        None if pattern == "stockinette" => Construction::Knitted,
+        None => Construction::Woven,
+    };
+    let (q, report) = reference_state(
+        &p,
+        &YarnMaterial::default(),
+        construction,
+        &SolverOptions::default(),
+        &ReferenceOptions {
+            stress_free_and_tension: !equilibrate_only,
+            ..Default::default()
+        },
+    )
+    .map_err(|e| format!("{pattern}: {e}"))?;
+    q.save_pyp(out).map_err(|e| e.to_string())?;
+    println!(
+        "{pattern} ({}): {} stress-free round(s) (relaxed energy {:.2e} J); zero-stress periods \
+         {:.6e} x {:.6e} m (strain {:+.4}%, {:+.4}%, {} Newton steps, residual tile forces {:.1e}, {:.1e} N); \
+         Ψ̄(0) = {:.6e} J/m²; {:.2} s; wrote {}",
+        if equilibrate_only {
+            "equilibrated only".to_string()
+        } else {
+            format!("{construction:?}")
+        },
+        report.rounds,
+        report.stress_free_energy,
+        report.periods_out[0],
+        report.periods_out[1],
+        100.0 * report.period_strain[0],
+        100.0 * report.period_strain[1],
+        report.period_steps,
+        report.residual_force[0],
+        report.residual_force[1],
+        report.psi,
+        report.time,
+        out.display()
+    );
+    if let Some(path) = json_out {
+        let text = serde_json::to_string_pretty(&report).map_err(|e| e.to_string())?;
+        std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    Ok(true)
+}
