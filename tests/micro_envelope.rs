@@ -7,8 +7,10 @@ use hylc::pattern::generate::default_pattern;
 use hylc::rod::YarnMaterial;
 
 fn problem(material: &YarnMaterial) -> MicroProblem {
+    // force test only (the decrement test is looser than 1e-11 k_s on this small tile)
     let options = SolverOptions {
         tolerance: 1e-11,
+        decrement_tolerance: 0.0,
         ..Default::default()
     };
     MicroProblem::new(default_pattern("plain").unwrap(), material, options)
@@ -29,6 +31,7 @@ fn rel(a: f64, b: f64, scale: f64) -> f64 {
 fn strain_derivatives_match_resolves() {
     let m = YarnMaterial::default();
     let p = problem(&m);
+    let mut worst: f64 = 0.0;
     for z in [
         MacroStrain::in_plane(0.03, 0.1, -0.02),
         MacroStrain::new(0.03, 0.1, -0.02, 40.0, 0.0),
@@ -55,8 +58,10 @@ fn strain_derivatives_match_resolves() {
                 e <= 1e-4,
                 "{z} component {j}: envelope {an:e} vs re-solve FD {fd:e} (rel {e:.2e})"
             );
+            worst = worst.max(e);
         }
     }
+    eprintln!("∂Ψ̄/∂z against re-solves: worst relative error {worst:.2e}");
 }
 
 #[test]
@@ -67,6 +72,7 @@ fn parameter_derivatives_match_resolves() {
     let sol = p.solve(&z, None).unwrap();
     let d = parameter_derivatives(&p, &sol).unwrap();
     let psi0 = sol.psi().unwrap();
+    let mut worst: f64 = 0.0;
     for (k, name) in PARAMETER_NAMES.iter().enumerate() {
         let set = |m: &mut YarnMaterial, v: f64| match k {
             0 => m.young = v,
@@ -105,5 +111,81 @@ fn parameter_derivatives_match_resolves() {
             "∂Ψ̄/∂{name}: envelope {:e} vs re-solve FD {fd:e} (rel {e:.2e})",
             d[k]
         );
+        worst = worst.max(e);
     }
+    eprintln!("∂Ψ̄/∂(Y, G, γ, k_c, r) against re-solves: worst relative error {worst:.2e}");
+}
+
+#[test]
+fn second_derivatives_and_shape_sensitivity_match_resolves() {
+    use hylc::micro::envelope::strain_stiffness;
+    let m = YarnMaterial::default();
+    let p = problem(&m);
+    let (mut worst_h, mut worst_y): (f64, f64) = (0.0, 0.0);
+    for z in [
+        MacroStrain::in_plane(0.03, 0.1, -0.02),
+        MacroStrain::new(0.03, 0.1, -0.02, 40.0, 0.0),
+    ] {
+        let sol = p.solve(&z, None).unwrap();
+        let st = strain_stiffness(&p, &sol.state).unwrap();
+        let stress = |s: &hylc::micro::MicroState| strain_derivatives(&p, s).unwrap();
+        let hmax = st.hessian.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        for (col, &j) in st.components.iter().enumerate() {
+            // steps large enough that the re-solves' own accuracy (force test 1e-11 k_s) does not dominate
+            let h = if j < 3 { 1e-3 } else { 0.5 };
+            let solve = |sign: f64| {
+                let mut zz = z;
+                zz.0[j] += sign * h;
+                let s = p.solve(&zz, Some(&sol.state)).unwrap();
+                assert_eq!(s.status, Status::Converged);
+                s
+            };
+            let (sp, sm) = (solve(1.0), solve(-1.0));
+            let (dp, dm) = (stress(&sp.state), stress(&sm.state));
+            for (row, &i) in st.components.iter().enumerate() {
+                let fd = (dp[i].unwrap() - dm[i].unwrap()) / (2.0 * h);
+                let an = st.hessian[(row, col)];
+                let e = (an - fd).abs() / (fd.abs() + 1e-3 * hmax);
+                assert!(
+                    e <= 1e-4,
+                    "{z} d²Ψ̄/dz{i}dz{j}: {an:e} vs re-solve FD {fd:e} (rel {e:.2e})"
+                );
+                worst_h = worst_h.max(e);
+            }
+            let fd: Vec<f64> = sp
+                .state
+                .y
+                .iter()
+                .zip(&sm.state.y)
+                .map(|(a, b)| (a - b) / (2.0 * h))
+                .collect();
+            let diff = fd
+                .iter()
+                .zip(&st.dy[col])
+                .map(|(a, b)| (a - b).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let norm = fd.iter().map(|a| a * a).sum::<f64>().sqrt();
+            let nu = 3 * p.pattern.len();
+            let part = |lo: usize, hi: usize| {
+                let d = (lo..hi)
+                    .map(|i| (fd[i] - st.dy[col][i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                let n = (lo..hi).map(|i| fd[i].powi(2)).sum::<f64>().sqrt();
+                (d, n)
+            };
+            assert!(
+                diff <= 1e-4 * norm,
+                "{z} dy*/dz{j}: rel {:.2e}; displacements (err, norm) {:?}, angles {:?}",
+                diff / norm,
+                part(0, nu),
+                part(nu, fd.len())
+            );
+            worst_y = worst_y.max(diff / norm);
+        }
+    }
+    eprintln!(
+        "d²Ψ̄/dz² and dy*/dz against re-solves: worst relative errors {worst_h:.2e}, {worst_y:.2e}"
+    );
 }

@@ -150,3 +150,119 @@ pub fn parameter_derivatives(
         (2.0 * e.stretch / r + 4.0 * (e.bend + e.twist) / r + dc_dr) / area,
     ])
 }
+
+/// Second derivatives of Ψ̄ with respect to the strain components of a state's family, and the sensitivity of
+/// the equilibrium unknowns (`03-homogenization.md`, section 5).
+#[derive(Clone, Debug)]
+pub struct StrainStiffness {
+    /// The strain components (indices into z) of the rows and columns.
+    pub components: Vec<usize>,
+    /// d²Ψ̄/dz_i dz_j (J/m² per unit strain²).
+    pub hessian: nalgebra::DMatrix<f64>,
+    /// dy*/dz_k in the tile's dof layout (ũ in m, θ in rad), one vector per component.
+    pub dy: Vec<Vec<f64>>,
+}
+
+/// The reduced gradient (tile dofs) of a state at its own strain.
+fn gradient_at(problem: &MicroProblem, state: &MicroState) -> Result<Vec<f64>, MicroError> {
+    let p = &problem.pattern;
+    let elim = Elimination::in_family(p, &state.strain, state.family);
+    let mut tile = problem.tile(&elim);
+    let x = tile.home_positions(&state.y);
+    tile.update_contacts(&x, problem.options.contact_margin * p.radius)?;
+    let ev = tile.evaluate(&state.frames, &state.y, Want::Gradient, &Terms::ALL)?;
+    Ok(ev.gradient.expect("asked for").iter().copied().collect())
+}
+
+/// d²Ψ̄/dz² = (1/A)(∂²E/∂z² − (∂²E/∂y∂z)ᵀ H⁻¹ ∂²E/∂y∂z) and dy*/dz = −H⁻¹ ∂²E/∂y∂z on the constraint space, with
+/// one factorisation of the Newton matrix H (unit scaling and μ floor as in the solver). The mixed derivatives
+/// ∂²E/∂y∂z and ∂²E/∂z² are central differences (step 1e-5 in strain, 1e-5/max(p) in curvature) of the analytic
+/// reduced gradient and of the analytic envelope gradient at fixed unknowns, the frames moved with the strain as
+/// in a warm start. The components are those of the state's family (`BendY`: s_x, s_a, s_y, Π₁₁; `BendX`: s_x,
+/// s_a, s_y, Π₀₀).
+pub fn strain_stiffness(
+    problem: &MicroProblem,
+    state: &MicroState,
+) -> Result<StrainStiffness, MicroError> {
+    let p = &problem.pattern;
+    let n = p.len();
+    let nd = 4 * n;
+    let r = p.radius;
+    let area = p.periods[0] * p.periods[1];
+    let components: Vec<usize> = match state.family {
+        Family::BendY => vec![0, 1, 2, 4],
+        Family::BendX => vec![0, 1, 2, 3],
+    };
+    let pmax = p.periods[0].max(p.periods[1]);
+    let k = components.len();
+    let mut b: Vec<Vec<f64>> = Vec::with_capacity(k);
+    let mut ezz = nalgebra::DMatrix::zeros(k, k);
+    for (col, &j) in components.iter().enumerate() {
+        let h = if j < 3 { 1e-5 } else { 1e-5 / pmax };
+        let moved = |sign: f64| -> Result<MicroState, MicroError> {
+            let mut s = state.clone();
+            let mut z = s.strain;
+            z.0[j] += sign * h;
+            problem.move_to(&mut s, &z)?;
+            Ok(s)
+        };
+        let (sp, sm) = (moved(1.0)?, moved(-1.0)?);
+        let (gp, gm) = (gradient_at(problem, &sp)?, gradient_at(problem, &sm)?);
+        b.push((0..nd).map(|i| (gp[i] - gm[i]) / (2.0 * h)).collect());
+        let (dp, dm) = (
+            energy_strain_gradient(problem, &sp)?,
+            energy_strain_gradient(problem, &sm)?,
+        );
+        for (row, &i) in components.iter().enumerate() {
+            ezz[(row, col)] =
+                (dp[i].expect("family component") - dm[i].expect("family component")) / (2.0 * h);
+        }
+    }
+    let ezz = (&ezz + ezz.transpose()) * 0.5;
+
+    // the scaled Newton matrix at the equilibrium
+    let elim = Elimination::in_family(p, &state.strain, state.family);
+    let mut tile = problem.tile(&elim);
+    let x = tile.home_positions(&state.y);
+    tile.update_contacts(&x, problem.options.contact_margin * r)?;
+    let ev = tile.evaluate(&state.frames, &state.y, Want::Hessian, &Terms::ALL)?;
+    let scale = |i: usize| if i < 3 * n { 1.0 } else { 1.0 / r };
+    let lower: Vec<(usize, usize, f64)> = ev
+        .hessian
+        .expect("asked for")
+        .into_iter()
+        .filter(|&(i, j, _)| i >= j)
+        .map(|(i, j, v)| (i, j, v * scale(i) * scale(j)))
+        .collect();
+    let diag_max = lower
+        .iter()
+        .filter(|t| t.0 == t.1)
+        .fold(0.0f64, |m, t| m.max(t.2.abs()))
+        .max(problem.material.stretch_stiffness() / r);
+    let bs: Vec<Vec<f64>> = b
+        .iter()
+        .map(|v| v.iter().enumerate().map(|(i, x)| x * scale(i)).collect())
+        .collect();
+    let mut kkt = super::linear::KktSolver::default();
+    let delta = kkt
+        .solve_refined(nd, &lower, 1e-10 * diag_max, &bs, problem.constraints(), 3)
+        .map_err(MicroError::Linear)?;
+    // δ_k = −H_s⁻¹ S b_k: bᵀH⁻¹b = −(S b_i)·δ_j; dy/dz_k = S δ_k
+    let mut hessian = nalgebra::DMatrix::zeros(k, k);
+    for i in 0..k {
+        for j in 0..k {
+            let bkb: f64 = -bs[i].iter().zip(&delta[j]).map(|(a, d)| a * d).sum::<f64>();
+            hessian[(i, j)] = (ezz[(i, j)] - bkb) / area;
+        }
+    }
+    let hessian = (&hessian + hessian.transpose()) * 0.5;
+    let dy = delta
+        .into_iter()
+        .map(|d| d.iter().enumerate().map(|(i, x)| x * scale(i)).collect())
+        .collect();
+    Ok(StrainStiffness {
+        components,
+        hessian,
+        dy,
+    })
+}

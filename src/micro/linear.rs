@@ -46,6 +46,36 @@ impl KktSolver {
         g: &[f64],
         a: &[Vec<f64>],
     ) -> Result<Vec<f64>, FactorError> {
+        let mut out = self.solve_many(n, lower, mu, &[g.to_vec()], a)?;
+        Ok(out.pop().expect("one right-hand side"))
+    }
+
+    /// [`solve`](Self::solve) for several right-hand sides with one factorisation: for each b returns
+    /// δ = −(H + μI)⁻¹ (b + Aᵀλ) with A δ = 0, i.e. minus the constrained inverse applied to b.
+    pub fn solve_many(
+        &mut self,
+        n: usize,
+        lower: &[(usize, usize, f64)],
+        mu: f64,
+        rhs_list: &[Vec<f64>],
+        a: &[Vec<f64>],
+    ) -> Result<Vec<Vec<f64>>, FactorError> {
+        self.solve_refined(n, lower, mu, rhs_list, a, 0)
+    }
+
+    /// [`solve_many`](Self::solve_many) followed by `refine` steps of iterative refinement against the
+    /// unshifted H: δ ← δ + solve(b + H δ). Each step shrinks the error of the shift μ by about μ/λ on the
+    /// constraint space (λ the smallest eigenvalue there), so the result tends to the exact constrained solve
+    /// while the factorisation stays regularised (the exact rigid modes are removed by the constraints).
+    pub fn solve_refined(
+        &mut self,
+        n: usize,
+        lower: &[(usize, usize, f64)],
+        mu: f64,
+        rhs_list: &[Vec<f64>],
+        a: &[Vec<f64>],
+        refine: usize,
+    ) -> Result<Vec<Vec<f64>>, FactorError> {
         let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(lower.len() + n);
         trip.extend(lower.iter().map(|&(i, j, v)| Triplet::new(i, j, v)));
         trip.extend((0..n).map(|i| Triplet::new(i, i, mu)));
@@ -68,10 +98,12 @@ impl KktSolver {
         self.values.clear();
         self.values.resize(symbolic.len_val(), 0.0);
         let par = Par::Seq;
+        let k = rhs_list.len();
+        let m = a.len();
         let mut buf = MemBuffer::new(
             symbolic
                 .factorize_numeric_llt_scratch::<f64>(par, Default::default())
-                .or(symbolic.solve_in_place_scratch::<f64>(1 + a.len(), par)),
+                .or(symbolic.solve_in_place_scratch::<f64>(k.max(m).max(1), par)),
         );
         let llt: LltRef<'_, usize, f64> = symbolic
             .factorize_numeric_llt(
@@ -87,33 +119,78 @@ impl KktSolver {
                 Default::default(),
             )
             .map_err(|_| FactorError::NotPositiveDefinite)?;
-        let m = a.len();
-        let mut rhs = Mat::<f64>::from_fn(n, 1 + m, |i, j| if j == 0 { g[i] } else { a[j - 1][i] });
-        llt.solve_in_place_with_conj(Conj::No, rhs.as_mut(), par, MemStack::new(&mut buf));
-        // x_g = (H+μI)⁻¹ g, X_A = (H+μI)⁻¹ Aᵀ; λ = −S⁻¹ A x_g; δ = −(x_g + X_A λ)
-        let dot = |row: &[f64], col: usize| -> f64 { (0..n).map(|i| row[i] * rhs[(i, col)]).sum() };
-        let mut delta: Vec<f64> = (0..n).map(|i| -rhs[(i, 0)]).collect();
-        if m > 0 {
-            let s = DMatrix::from_fn(m, m, |i, j| dot(&a[i], 1 + j));
-            let ax = DVector::from_fn(m, |i, _| dot(&a[i], 0));
-            let lambda = s
-                .clone()
-                .cholesky()
-                .map(|c| c.solve(&(-&ax)))
-                .or_else(|| s.lu().solve(&(-&ax)))
-                .ok_or(FactorError::SingularConstraints)?;
-            for (i, d) in delta.iter_mut().enumerate() {
-                let mut t = 0.0;
-                for k in 0..m {
-                    t += rhs[(i, 1 + k)] * lambda[k];
+        let mut solve_cols = |cols: &[&[f64]]| -> Mat<f64> {
+            let mut rhs = Mat::<f64>::from_fn(n, cols.len(), |i, j| cols[j][i]);
+            llt.solve_in_place_with_conj(Conj::No, rhs.as_mut(), par, MemStack::new(&mut buf));
+            rhs
+        };
+        // X_A = (H+μI)⁻¹ Aᵀ and the Schur complement S = A X_A
+        let xa = solve_cols(&a.iter().map(|r| r.as_slice()).collect::<Vec<_>>());
+        let sinv = if m > 0 {
+            let s = DMatrix::from_fn(m, m, |i, j| {
+                (0..n).map(|q| a[i][q] * xa[(q, j)]).sum::<f64>()
+            });
+            Some(
+                s.clone()
+                    .cholesky()
+                    .map(|c| c.inverse())
+                    .or_else(|| s.try_inverse())
+                    .ok_or(FactorError::SingularConstraints)?,
+            )
+        } else {
+            None
+        };
+        // δ = −(x + X_A λ), x = (H+μI)⁻¹ b, λ = −S⁻¹ A x
+        let mut apply = |cols: &[&[f64]]| -> Vec<Vec<f64>> {
+            let x = solve_cols(cols);
+            (0..cols.len())
+                .map(|c| {
+                    let mut delta: Vec<f64> = (0..n).map(|i| -x[(i, c)]).collect();
+                    if let Some(sinv) = &sinv {
+                        let ax = DVector::from_fn(m, |i, _| {
+                            (0..n).map(|q| a[i][q] * x[(q, c)]).sum::<f64>()
+                        });
+                        let lambda = -(sinv * ax);
+                        for (i, d) in delta.iter_mut().enumerate() {
+                            let mut t = 0.0;
+                            for q in 0..m {
+                                t += xa[(i, q)] * lambda[q];
+                            }
+                            *d -= t;
+                        }
+                    }
+                    delta
+                })
+                .collect()
+        };
+        let mut out = apply(&rhs_list.iter().map(|r| r.as_slice()).collect::<Vec<_>>());
+        for _ in 0..refine {
+            // residual b + H δ with the unshifted symmetric H (lower triangle stored)
+            let res: Vec<Vec<f64>> = out
+                .iter()
+                .zip(rhs_list)
+                .map(|(d, b)| {
+                    let mut r = b.clone();
+                    for &(i, j, v) in lower {
+                        r[i] += v * d[j];
+                        if i != j {
+                            r[j] += v * d[i];
+                        }
+                    }
+                    r
+                })
+                .collect();
+            let corr = apply(&res.iter().map(|r| r.as_slice()).collect::<Vec<_>>());
+            for (d, c) in out.iter_mut().zip(corr) {
+                for (x, y) in d.iter_mut().zip(c) {
+                    *x += y;
                 }
-                *d -= t;
             }
         }
-        if delta.iter().any(|v| !v.is_finite()) {
+        if out.iter().flatten().any(|v| !v.is_finite()) {
             return Err(FactorError::NotPositiveDefinite);
         }
-        Ok(delta)
+        Ok(out)
     }
 }
 

@@ -32,6 +32,10 @@ use std::time::Instant;
 pub struct SolverOptions {
     /// Dimensionless force tolerance: converged when ‖g‖_∞ ≤ tolerance · k_s.
     pub tolerance: f64,
+    /// Newton-decrement test: converged when |gᵀδy| ≤ decrement_tolerance · (|E| + k_s r) (design default
+    /// 1e-14). For a small tile this is looser than the force test (|E| ≪ k_s r), so derivative checks against
+    /// re-solves set it to 0 and rely on the force test alone.
+    pub decrement_tolerance: f64,
     /// Newton step limit.
     pub max_steps: usize,
     /// Wall-time limit per solve (seconds), none by default.
@@ -50,6 +54,7 @@ impl Default for SolverOptions {
     fn default() -> Self {
         SolverOptions {
             tolerance: 1e-8,
+            decrement_tolerance: 1e-14,
             max_steps: 2000,
             time_limit: None,
             step_factor: 1.0,
@@ -455,13 +460,26 @@ impl MicroProblem {
                 .max(ks / r);
             // The tile's rigid motions make H exactly singular: a factorisation at μ = 0 "succeeds" with pivots at
             // round-off level and returns noise. μ therefore never drops below 1e-10 of the largest diagonal
-            // entry (the constraints remove those modes from the step; the shift changes the step by O(1e-10)
-            // relative in the others). A step that is not a descent direction counts as a failed factorisation.
+            // entry (the constraints remove those modes from the step), and at that floor two steps of iterative
+            // refinement against the unshifted H make the step an exact Newton step also along soft modes. A
+            // step that is not a descent direction counts as a failed factorisation.
             let mu_floor = 1e-10 * diag_max;
             mu = mu.max(mu_floor);
             let mut delta = None;
             for _ in 0..40 {
-                match kkt.solve(nd, &lower, mu, &g, &self.constraints) {
+                // at the floor, two refinement steps remove the shift's effect on soft modes (exact Newton)
+                let refine = if mu <= mu_floor { 2 } else { 0 };
+                let solved = kkt
+                    .solve_refined(
+                        nd,
+                        &lower,
+                        mu,
+                        std::slice::from_ref(&g),
+                        &self.constraints,
+                        refine,
+                    )
+                    .map(|mut v| v.pop().expect("one right-hand side"));
+                match solved {
                     Ok(d) if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 => {
                         delta = Some(d);
                         break;
@@ -478,7 +496,7 @@ impl MicroProblem {
                 return Ok(finish(state, Status::Stalled, steps, timings, max_mu));
             };
             let decrement: f64 = g.iter().zip(&delta).map(|(a, b)| a * b).sum();
-            if decrement.abs() <= 1e-14 * (energy.abs() + ks * r) {
+            if decrement.abs() <= opts.decrement_tolerance * (energy.abs() + ks * r) {
                 return Ok(finish(state, Status::Converged, steps, timings, max_mu));
             }
             // back to tile dofs (θ = y_θ / r), then the displacement limit
