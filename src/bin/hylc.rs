@@ -113,6 +113,9 @@ enum Command {
         /// Newton step limit
         #[arg(long, default_value_t = 2000)]
         max_steps: usize,
+        /// wall-time limit per solve in seconds
+        #[arg(long)]
+        time_limit: Option<f64>,
         /// displacement limit factor (times r λ_min(I))
         #[arg(long, default_value_t = 1.0)]
         step_factor: f64,
@@ -216,6 +219,7 @@ fn main() -> ExitCode {
             cold,
             tolerance,
             max_steps,
+            time_limit,
             step_factor,
             no_slide_constraints,
             obj,
@@ -226,6 +230,7 @@ fn main() -> ExitCode {
                 trace,
                 tolerance,
                 max_steps,
+                time_limit,
                 step_factor,
                 slide_constraints: !no_slide_constraints,
                 ..Default::default()

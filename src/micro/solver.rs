@@ -558,9 +558,10 @@ impl MicroProblem {
             if opts.trace {
                 eprintln!(
                     "step {steps}: E {energy:.15e} J, |g|inf {gnorm:.3e} N, g.d {decrement:.3e} J, mu {mu:.2e}, \
-                     |d|max {:.3e} m, accepted {}",
+                     |d|max {:.3e} m, accepted {}, symbolic analyses {}",
                     dmax_now.min(d_max),
-                    if accepted { format!("at {step:.0e}") } else { "none".into() }
+                    if accepted { format!("at {step:.0e}") } else { "none".into() },
+                    kkt.analyses
                 );
             }
             steps += 1;

@@ -1,0 +1,56 @@
+//! The micro solver's command line on bad input and on non-converged solves (issue 4, "Bad input"): strains
+//! outside the admissible set give a one-line error naming the component; a solve stopped early is reported with
+//! its status and a non-zero exit code, and no Ψ̄.
+
+mod common;
+
+use common::cli_error;
+use std::process::Command;
+
+#[test]
+fn inadmissible_strains_are_rejected_with_the_component_named() {
+    for (z, needle) in [
+        ("0,1,0", "s_a"),
+        ("0,-1.2,0", "s_a"),
+        ("-1,0,0", "1 + s_x"),
+        ("0,0,-2", "1 + s_y"),
+        ("0,0,0,10,20", "both"),
+        ("0,0,nan", "s_y"),
+        ("0,0", "expected 3"),
+        ("0,x,0", "cannot parse"),
+    ] {
+        let err = cli_error(&["solve", "plain", "--z", z]);
+        assert!(err.contains(needle), "--z {z}: {err}");
+    }
+}
+
+#[test]
+fn unknown_patterns_and_missing_construction_are_named() {
+    let err = cli_error(&["solve", "no-such-pattern"]);
+    assert!(err.contains("no-such-pattern"), "{err}");
+    let dir = std::env::temp_dir().join("hylc_micro_cli");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("plain.pyp");
+    let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
+        .args(["generate", "plain", "--out", file.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let out_pyp = dir.join("ref.pyp");
+    let err = cli_error(&["reference", file.to_str().unwrap(), "--out", out_pyp.to_str().unwrap()]);
+    assert!(err.contains("--construction"), "{err}");
+}
+
+#[test]
+fn a_solve_stopped_early_is_reported_and_has_no_psi() {
+    let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
+        .args(["solve", "plain", "--z", "0.3,0.4,0.1", "--max-steps", "1", "--json"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(3), "{out:?}");
+    let line = String::from_utf8(out.stdout).unwrap();
+    let v: serde_json::Value = serde_json::from_str(line.trim()).unwrap();
+    assert_eq!(v["status"], "MaxSteps");
+    assert!(v["psi"].is_null());
+    assert_eq!(v["steps"], 1);
+}
