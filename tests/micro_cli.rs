@@ -37,14 +37,27 @@ fn unknown_patterns_and_missing_construction_are_named() {
         .unwrap();
     assert!(out.status.success());
     let out_pyp = dir.join("ref.pyp");
-    let err = cli_error(&["reference", file.to_str().unwrap(), "--out", out_pyp.to_str().unwrap()]);
+    let err = cli_error(&[
+        "reference",
+        file.to_str().unwrap(),
+        "--out",
+        out_pyp.to_str().unwrap(),
+    ]);
     assert!(err.contains("--construction"), "{err}");
 }
 
 #[test]
 fn a_solve_stopped_early_is_reported_and_has_no_psi() {
     let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
-        .args(["solve", "plain", "--z", "0.3,0.4,0.1", "--max-steps", "1", "--json"])
+        .args([
+            "solve",
+            "plain",
+            "--z",
+            "0.3,0.4,0.1",
+            "--max-steps",
+            "1",
+            "--json",
+        ])
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(3), "{out:?}");

@@ -14,11 +14,12 @@ import sys
 HYLC = sys.argv[1] if len(sys.argv) > 1 else "target/release/hylc"
 SHARED = os.environ.get("HYLC_SHARED", "../shared")
 PATTERNS = ["basket", "satin", "slip_stitch_honeycomb", "stockinette", "cartridge_belt_rib"]
-# neighbouring strains: a stretch chain, a shear chain and a bending chain (steps as in a 150-sample 1D range)
+# neighbouring strains with the spacing of a default 150-sample 1D range of the original grid (s_x, s_y in
+# [-0.2, 1]: ~0.006 near zero; s_a in [-0.7, 0.7]: up to ~0.02), and a bending chain in steps of 5/m
 CHAINS = {
-    "s_x 0→0.2": [f"{0.02 * k:.4f},0,0" for k in range(11)],
-    "s_a 0→0.5": [f"0,{0.05 * k:.4f},0" for k in range(11)],
-    "II00 0→100/m": [f"0,0,0,{10.0 * k:.1f},0" for k in range(11)],
+    "s_x 0→0.06": [f"{0.006 * k:.4f},0,0" for k in range(11)],
+    "s_a 0→0.2": [f"0,{0.02 * k:.4f},0" for k in range(11)],
+    "II00 0→50/m": [f"0,0,0,{5.0 * k:.1f},0" for k in range(11)],
 }
 
 

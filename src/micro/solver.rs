@@ -390,6 +390,10 @@ impl MicroProblem {
         let tc = Instant::now();
         let mut contact_at = tile.home_positions(&state.y);
         tile.update_contacts(&contact_at, margin)?;
+        // contact pairs that have been within reach since the last candidate update: their blocks stay in the
+        // matrix structure (as explicit zeros when inactive), so the symbolic analysis is reused
+        let mut ever_active = vec![false; tile.contacts.len()];
+        let rod_structure = rod_structure(&tile);
         timings.contact += tc.elapsed().as_secs_f64();
 
         // unit scaling M: the angular unknown is r θ
@@ -445,7 +449,7 @@ impl MicroProblem {
 
             // KKT step, growing μ until H + μI factorises
             let tf = Instant::now();
-            let lower: Vec<(usize, usize, f64)> = ev
+            let mut lower: Vec<(usize, usize, f64)> = ev
                 .hessian
                 .as_ref()
                 .expect("asked for")
@@ -453,6 +457,8 @@ impl MicroProblem {
                 .filter(|&&(i, j, _)| i >= j)
                 .map(|&(i, j, v)| (i, j, v * scale(i) * scale(j)))
                 .collect();
+            lower.extend_from_slice(&rod_structure);
+            contact_structure(&tile, &state.y, &mut ever_active, &mut lower);
             let diag_max = lower
                 .iter()
                 .filter(|t| t.0 == t.1)
@@ -532,6 +538,7 @@ impl MicroProblem {
                     let tc = Instant::now();
                     if tile.update_contacts(&positions, margin).is_ok() {
                         contact_at = positions.clone();
+                        ever_active = vec![false; tile.contacts.len()];
                     }
                     timings.contact += tc.elapsed().as_secs_f64();
                 }
@@ -575,6 +582,58 @@ impl MicroProblem {
                 return Ok(finish(state, status, steps, timings, max_mu));
             }
             mu = (mu / 10.0).max(mu_floor);
+        }
+    }
+}
+
+/// Explicit zeros on every (lower) dof pair of the rod stencils: the part of the matrix structure that never
+/// changes.
+fn rod_structure(tile: &Tile) -> Vec<(usize, usize, f64)> {
+    let n = tile.pattern.len();
+    let mut out = Vec::new();
+    let mut push_all = |dofs: &[usize]| {
+        for &a in dofs {
+            for &b in dofs {
+                if a >= b {
+                    out.push((a, b, 0.0));
+                }
+            }
+        }
+    };
+    for s in &tile.topology.stencils {
+        let mut dofs: Vec<usize> = s.vertices.iter().flat_map(|&v| 3 * v..3 * v + 3).collect();
+        dofs.push(3 * n + s.edges[0]);
+        dofs.push(3 * n + s.edges[1]);
+        push_all(&dofs);
+    }
+    out
+}
+
+/// Mark the contact candidates within reach at `y` and add explicit zeros for the blocks of every pair marked
+/// since the last candidate update.
+fn contact_structure(
+    tile: &Tile,
+    y: &[f64],
+    ever_active: &mut [bool],
+    lower: &mut Vec<(usize, usize, f64)>,
+) {
+    let reach = 2.0 * tile.contact_radius;
+    for (k, pair) in tile.contacts.iter().enumerate() {
+        let pts = pair.points(tile);
+        if !ever_active[k] {
+            let x = pts.map(|(v, o)| tile.position(y, v, o));
+            let (d2, _, _) = crate::contact::segment_distance_squared(&x[0], &x[1], &x[2], &x[3]);
+            ever_active[k] = d2 < reach * reach * 1.0001;
+        }
+        if ever_active[k] {
+            let dofs: Vec<usize> = pts.iter().flat_map(|&(v, _)| 3 * v..3 * v + 3).collect();
+            for &a in &dofs {
+                for &b in &dofs {
+                    if a >= b {
+                        lower.push((a, b, 0.0));
+                    }
+                }
+            }
         }
     }
 }

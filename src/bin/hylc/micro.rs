@@ -200,7 +200,8 @@ pub fn sensitivity(pattern: &str, z: &str, options: SolverOptions) -> Result<boo
     for (n, v) in PARAMETER_NAMES.iter().zip(dp) {
         println!("  ∂Ψ̄/∂{n} = {v:.6e}");
     }
-    let st = hylc::micro::envelope::strain_stiffness(&problem, &sol.state).map_err(|e| e.to_string())?;
+    let st =
+        hylc::micro::envelope::strain_stiffness(&problem, &sol.state).map_err(|e| e.to_string())?;
     let names: Vec<&str> = st.components.iter().map(|&k| STRAIN_NAMES[k]).collect();
     println!("  d²Ψ̄/dz² over ({}):", names.join(", "));
     for i in 0..names.len() {
