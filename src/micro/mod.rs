@@ -7,6 +7,7 @@
 
 pub mod elimination;
 pub mod envelope;
+pub mod grid;
 pub mod linear;
 pub mod solver;
 pub mod strain;
