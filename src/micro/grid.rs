@@ -662,6 +662,12 @@ pub struct GridSummary {
     /// The same after removing, per grid point, each yarn's mean difference (per-yarn translations, a
     /// diagnostic for sliding modes; it also removes genuine relative yarn motion).
     pub position_error_yarn_translation_removed: ErrorStats,
+    /// The same after sliding each of our yarns rigidly along the axis the original pins: the original data holds
+    /// one vertex per yarn whose displacement along ξ₁ (or ξ₂) is zero at every grid point (its no-slide
+    /// constraint); we shift that component of the yarn's vertices so that ours is zero there too.
+    pub position_error_pinned_like_original: ErrorStats,
+    /// The pinned (vertex, component) pairs found in the original data (component 0: ξ₁, 1: ξ₂).
+    pub original_pins: Vec<(usize, usize)>,
     /// RMS of the error per component (dξ₁, dξ₂, dh), units of r.
     pub position_error_rms_components: [f64; 3],
     /// RMS position error (r) per axis value: over the grid points with s_x (row 0), s_a (row 1), s_y (row 2)
@@ -710,6 +716,11 @@ pub fn summarize(problem: &MicroProblem, data: &GridData, run: &GridRun) -> Grid
         y
     };
     let n_yarns = yarn_of.iter().max().map_or(0, |m| m + 1);
+    let pins: Vec<(usize, usize)> = (0..n)
+        .flat_map(|v| (0..2).map(move |c| (v, c)))
+        .filter(|&(v, c)| (0..GRID_LEN).all(|g| data.row(g, v)[c].abs() < 1e-12))
+        .collect();
+    let mut pos_pin = Accum::default();
     let mut pos = Accum::default();
     let mut pos_t = Accum::default();
     let mut pos_y = Accum::default();
@@ -748,6 +759,13 @@ pub fn summarize(problem: &MicroProblem, data: &GridData, run: &GridRun) -> Grid
                 m.iter_mut().for_each(|x| *x /= k.max(1) as f64);
             }
             let norm = |d: [f64; 3]| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() / r;
+            let mut pinned = diff.clone();
+            for &(vp, c) in &pins {
+                let shift = diff[vp][c];
+                for v in (0..n).filter(|&v| yarn_of[v] == yarn_of[vp]) {
+                    pinned[v][c] -= shift;
+                }
+            }
             let mut point_sum2 = 0.0;
             for v in 0..n {
                 let d = [diff[v][0], diff[v][1], diff[v][2]];
@@ -759,6 +777,7 @@ pub fn summarize(problem: &MicroProblem, data: &GridData, run: &GridRun) -> Grid
                     comp[c] += (d[c] / r).powi(2);
                 }
                 pos_t.add(norm(std::array::from_fn(|c| d[c] - mean[c])), g, v);
+                pos_pin.add(norm(std::array::from_fn(|c| pinned[v][c])), g, v);
                 let ym = yarn_mean[yarn_of[v]];
                 pos_y.add(norm(std::array::from_fn(|c| d[c] - ym[c])), g, v);
                 th.add(diff[v][3].abs(), g, v);
@@ -852,6 +871,8 @@ pub fn summarize(problem: &MicroProblem, data: &GridData, run: &GridRun) -> Grid
         position_error: pos.stats(data),
         position_error_translation_removed: pos_t.stats(data),
         position_error_yarn_translation_removed: pos_y.stats(data),
+        position_error_pinned_like_original: pos_pin.stats(data),
+        original_pins: pins,
         position_error_rms_components: comp.map(|s| (s / count).sqrt()),
         position_error_rms_by_axis: by_axis.map(|row| {
             row.map(|(s, k)| {

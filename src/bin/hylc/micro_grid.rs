@@ -125,6 +125,12 @@ fn print_summary(pattern: &str, s: &GridSummary) {
         s.position_error_yarn_translation_removed.max
     );
     println!(
+        "  slid like the original's pins {:?}: RMS {:.4}, max {:.4}",
+        s.original_pins,
+        s.position_error_pinned_like_original.rms,
+        s.position_error_pinned_like_original.max
+    );
+    println!(
         "  original displacement (r): RMS {:.4}, max {:.4}",
         s.original_displacement.rms, s.original_displacement.max
     );
