@@ -163,6 +163,10 @@ enum Command {
         /// no per-yarn slide constraints
         #[arg(long)]
         no_slide_constraints: bool,
+        /// keep the `.pyp` file's periods even where they disagree with the rest lengths (by default the
+        /// implied periods are used, as in `hylc solve`)
+        #[arg(long)]
+        file_periods: bool,
     },
     /// Calibrate the yarn parameters so that the original reference patterns are static equilibria: per contact
     /// form, the residual force at the defaults, the best parameters per pattern and the joint fit.
@@ -255,6 +259,7 @@ fn main() -> ExitCode {
             tolerance,
             max_steps,
             no_slide_constraints,
+            file_periods,
         } => {
             let options = hylc::micro::SolverOptions {
                 tolerance,
@@ -268,6 +273,7 @@ fn main() -> ExitCode {
                 json.as_deref(),
                 limit,
                 cold_every,
+                file_periods,
                 options,
             )
             .map(|ok| {

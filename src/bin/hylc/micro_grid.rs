@@ -16,9 +16,17 @@ pub fn run(
     json: Option<&Path>,
     limit: Option<usize>,
     cold_every: usize,
+    file_periods: bool,
     options: SolverOptions,
 ) -> Result<bool, String> {
-    let p = load_pattern(pattern)?;
+    let p = if file_periods {
+        // the periods as written, even where they disagree with the rest lengths (a diagnostic for basket)
+        hylc::pattern::Pattern::load_pyp(pattern)
+            .map_err(|e| e.to_string())?
+            .0
+    } else {
+        load_pattern(pattern)?
+    };
     let data = GridData::load(data_dir).map_err(|e| e.to_string())?;
     data.check_pattern(&p)
         .map_err(|e| format!("{pattern} with {}: {e}", data_dir.display()))?;
@@ -42,20 +50,31 @@ pub fn run(
     let summary = summarize(&problem, &data, &run);
     print_summary(pattern, &summary);
     if let Some(path) = json {
-        write_json(path, pattern, data_dir, &problem.options, &summary)?;
+        write_json(
+            path,
+            pattern,
+            data_dir,
+            &problem.options,
+            limit,
+            file_periods,
+            &summary,
+        )?;
         println!("wrote {}", path.display());
     }
     Ok(summary.converged == summary.points)
 }
 
 /// Add (or replace) this run's entry in the JSON file `path`: an object {"about": …, "runs": {key: …}} keyed by
-/// the pattern's file stem, with " (no slide constraints)" appended when they are off, so that several
+/// the pattern's file stem, with " (no slide constraints)" appended when they are off and " (first N points)" for
+/// a partial run, so that several
 /// `micro-grid` runs collect into one file. An existing file that is not such an object is left alone (error).
 fn write_json(
     path: &Path,
     pattern: &str,
     data_dir: &Path,
     options: &SolverOptions,
+    limit: Option<usize>,
+    file_periods: bool,
     summary: &GridSummary,
 ) -> Result<(), String> {
     let mut root = if path.exists() {
@@ -80,11 +99,16 @@ fn write_json(
     let stem = Path::new(pattern)
         .file_stem()
         .map_or(pattern.to_string(), |s| s.to_string_lossy().into_owned());
-    let key = if options.slide_constraints {
-        stem
-    } else {
-        format!("{stem} (no slide constraints)")
-    };
+    let mut key = stem;
+    if !options.slide_constraints {
+        key.push_str(" (no slide constraints)");
+    }
+    if file_periods {
+        key.push_str(" (file periods)");
+    }
+    if let Some(n) = limit.filter(|&n| n < GRID_LEN) {
+        key.push_str(&format!(" (first {n} points)"));
+    }
     root["runs"][key.as_str()] = serde_json::json!({
         "pattern": Path::new(pattern).file_name().map(|s| s.to_string_lossy().into_owned()),
         "data": data_dir.file_name().map(|s| s.to_string_lossy().into_owned()),
