@@ -624,6 +624,22 @@ impl StepStats {
     }
 }
 
+/// Our displacement field against the original's at one grid point (both relative to their z = 0 state, the
+/// position components (dξ₁, dξ₂, dh) of all vertices as one vector).
+#[derive(Clone, Debug, Serialize)]
+pub struct PointComparison {
+    /// (s_x, s_a, s_y).
+    pub strain: [f64; 3],
+    /// RMS position error over the vertices (r).
+    pub rms_error: f64,
+    /// RMS of the original displacement (r).
+    pub rms_original: f64,
+    /// cos ∠(ours, original): 1 when the fields have the same shape.
+    pub cosine: f64,
+    /// ‖ours‖ / ‖original‖: 1 when they have the same size.
+    pub magnitude_ratio: f64,
+}
+
 /// A failed attempt.
 #[derive(Clone, Debug, Serialize)]
 pub struct Failure {
@@ -680,6 +696,12 @@ pub struct GridSummary {
     pub theta_error: ErrorStats,
     /// RMS and max of the original dθ relative to its z = 0 state (rad).
     pub original_theta: ErrorStats,
+    /// cos ∠(ours, original) of the displacement fields over all compared grid points and vertices.
+    pub cosine: f64,
+    /// ‖ours‖ / ‖original‖ of the displacement fields over all compared grid points and vertices.
+    pub magnitude_ratio: f64,
+    /// The comparison at the grid points one index step from the start point (the smallest strains).
+    pub first_neighbours: Vec<PointComparison>,
     /// The grid points with the largest RMS position error: ((s_x, s_a, s_y), RMS in r).
     pub worst_points: Vec<([f64; 3], f64)>,
     /// The vertices with the largest RMS position error over the grid: (vertex, RMS in r).
@@ -731,6 +753,9 @@ pub fn summarize(problem: &MicroProblem, data: &GridData, run: &GridRun) -> Grid
     let mut per_point = Vec::new();
     let mut per_vertex = vec![0.0; n];
     let mut per_vertex_count = 0usize;
+    let (mut dot_all, mut ours_all, mut orig_all) = (0.0, 0.0, 0.0);
+    let mut first_neighbours = Vec::new();
+    let near = neighbours(run.zero);
     let mut by_axis = [[(0.0, 0usize); AXIS_LEN]; 3];
     if let Some(zero) = ours[run.zero].as_ref() {
         for pr in &run.points {
@@ -767,6 +792,31 @@ pub fn summarize(problem: &MicroProblem, data: &GridData, run: &GridRun) -> Grid
                 }
             }
             let mut point_sum2 = 0.0;
+            let (mut dot, mut oo, mut tt) = (0.0, 0.0, 0.0);
+            for v in 0..n {
+                let o = data.row(g, v);
+                let o0 = data.row(run.zero, v);
+                for c in 0..3 {
+                    let a = our[v][c] - zero[v][c];
+                    let b = o[c] - o0[c];
+                    dot += a * b;
+                    oo += a * a;
+                    tt += b * b;
+                }
+            }
+            dot_all += dot;
+            ours_all += oo;
+            orig_all += tt;
+            if near.contains(&g) {
+                let z = pr.strain.0;
+                first_neighbours.push(PointComparison {
+                    strain: [z[0], z[1], z[2]],
+                    rms_error: f64::NAN,
+                    rms_original: (tt / n as f64).sqrt() / r,
+                    cosine: dot / (oo * tt).sqrt(),
+                    magnitude_ratio: (oo / tt).sqrt(),
+                });
+            }
             for v in 0..n {
                 let d = [diff[v][0], diff[v][1], diff[v][2]];
                 let e = norm(d);
@@ -787,6 +837,9 @@ pub fn summarize(problem: &MicroProblem, data: &GridData, run: &GridRun) -> Grid
                 orig_th.add((o[3] - o0[3]).abs(), g, v);
             }
             per_vertex_count += 1;
+            if let Some(c) = first_neighbours.last_mut().filter(|_| near.contains(&g)) {
+                c.rms_error = (point_sum2 / n as f64).sqrt();
+            }
             for (k, &i) in grid_coords(g).iter().enumerate() {
                 by_axis[k][i].0 += point_sum2;
                 by_axis[k][i].1 += n;
@@ -885,6 +938,9 @@ pub fn summarize(problem: &MicroProblem, data: &GridData, run: &GridRun) -> Grid
         }),
         original_displacement: orig.stats(data),
         theta_error: th.stats(data),
+        cosine: dot_all / (ours_all * orig_all).sqrt(),
+        magnitude_ratio: (ours_all / orig_all).sqrt(),
+        first_neighbours,
         original_theta: orig_th.stats(data),
         worst_points: per_point,
         worst_vertices,

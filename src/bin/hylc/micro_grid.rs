@@ -167,6 +167,16 @@ fn print_summary(pattern: &str, s: &GridSummary) {
         s.original_theta.rms,
         s.original_theta.max
     );
+    println!(
+        "  displacement fields: cos ∠(ours, original) {:.3}, ‖ours‖/‖original‖ {:.3}",
+        s.cosine, s.magnitude_ratio
+    );
+    for c in &s.first_neighbours {
+        println!(
+            "    one step from z = 0 at {:?}: RMS error {:.4} r of {:.4} r, cos {:.3}, ratio {:.3}",
+            c.strain, c.rms_error, c.rms_original, c.cosine, c.magnitude_ratio
+        );
+    }
     for (label, st) in [("warm", &s.warm), ("cold", &s.cold)] {
         println!(
             "  {label}: {} solves ({} converged), steps median {} max {} mean {:.1}, time mean {:.3} s median {:.3} s",
