@@ -4,6 +4,8 @@
 mod calibrate;
 #[path = "hylc/micro.rs"]
 mod micro;
+#[path = "hylc/micro_grid.rs"]
+mod micro_grid;
 
 use clap::{Parser, Subcommand};
 use hylc::diff::{format_table, run_all, CheckConfig};
@@ -160,6 +162,37 @@ enum Command {
         #[arg(long = "z", allow_hyphen_values = true, default_value = "0,0,0")]
         z: String,
     },
+    /// Our micro solver against the original solver's displacements on the 9×9×9 in-plane strain grid
+    /// (validation item 3c): warm-started continuation over the grid, position and θ errors relative to each
+    /// side's z = 0 state, convergence with every failure, Newton steps warm vs cold.
+    MicroGrid {
+        /// `.pyp` file of the original pattern
+        pattern: String,
+        /// folder with `axes.txt` and `data.npy` (e.g. ../shared/data/hylc2020/displacements/satin)
+        data_dir: PathBuf,
+        /// write the summary as JSON
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// solve only the first N points of the continuation order (a quick partial run)
+        #[arg(long)]
+        limit: Option<usize>,
+        /// also solve every N-th grid point cold for the warm-vs-cold statistics (0: none)
+        #[arg(long, default_value_t = 16)]
+        cold_every: usize,
+        /// force tolerance relative to the stretching stiffness
+        #[arg(long, default_value_t = 1e-8)]
+        tolerance: f64,
+        /// Newton step limit
+        #[arg(long, default_value_t = 2000)]
+        max_steps: usize,
+        /// no per-yarn slide constraints
+        #[arg(long)]
+        no_slide_constraints: bool,
+        /// keep the `.pyp` file's periods even where they disagree with the rest lengths (by default the
+        /// implied periods are used, as in `hylc solve`)
+        #[arg(long)]
+        file_periods: bool,
+    },
     /// Calibrate the yarn parameters so that the original reference patterns are static equilibria: per contact
     /// form, the residual force at the defaults, the best parameters per pattern and the joint fit.
     Calibrate {
@@ -259,6 +292,40 @@ fn main() -> ExitCode {
         .map(|_| ExitCode::SUCCESS),
         Command::Sensitivity { pattern, z } => {
             micro::sensitivity(&pattern, &z, Default::default()).map(|_| ExitCode::SUCCESS)
+        }
+        Command::MicroGrid {
+            pattern,
+            data_dir,
+            json,
+            limit,
+            cold_every,
+            tolerance,
+            max_steps,
+            no_slide_constraints,
+            file_periods,
+        } => {
+            let options = hylc::micro::SolverOptions {
+                tolerance,
+                max_steps,
+                slide_constraints: !no_slide_constraints,
+                ..Default::default()
+            };
+            micro_grid::run(
+                &pattern,
+                &data_dir,
+                json.as_deref(),
+                limit,
+                cold_every,
+                file_periods,
+                options,
+            )
+            .map(|ok| {
+                if ok {
+                    ExitCode::SUCCESS
+                } else {
+                    ExitCode::from(3)
+                }
+            })
         }
         Command::Calibrate {
             dir,

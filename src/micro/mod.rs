@@ -8,6 +8,7 @@
 mod checks;
 pub mod elimination;
 pub mod envelope;
+pub mod grid;
 pub mod linear;
 pub mod reference;
 pub mod solver;
