@@ -117,6 +117,10 @@ pub struct DofMap {
     pub rotation: Vec<Matrix3<f64>>,
 }
 
+/// Force and moment resultants (F_o, M_o) of the stencil forces on the copies at one offset o
+/// ([`Tile::offset_resultants`]).
+pub type OffsetResultant = ([i32; 2], Vector3<f64>, Vector3<f64>);
+
 /// A periodic tile ready to evaluate: the pattern's rest values, the material, the rod topology and the contact
 /// pairs.
 pub struct Tile<'a> {
@@ -325,7 +329,7 @@ impl<'a> Tile<'a> {
         frames: &RodState,
         y: &[f64],
         terms: &Terms,
-    ) -> Result<Vec<([i32; 2], Vector3<f64>, Vector3<f64>)>, ContactError> {
+    ) -> Result<Vec<OffsetResultant>, ContactError> {
         use std::collections::BTreeMap;
         let n = self.pattern.len();
         let mut acc = BTreeMap::new();
