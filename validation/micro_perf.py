@@ -3,7 +3,7 @@
 solve, cold (from the reference state) and warm-started from the neighbouring strain of a chain, and where the
 time goes. Uses only the `hylc solve --json` timing output.
 
-usage: validation/micro_perf.py [path/to/hylc] > table.md
+usage: validation/micro_perf.py [path/to/hylc] [extra hylc solve options ...] > table.md
 """
 import json
 import os
@@ -12,6 +12,7 @@ import subprocess
 import sys
 
 HYLC = sys.argv[1] if len(sys.argv) > 1 else "target/release/hylc"
+EXTRA = sys.argv[2:]
 SHARED = os.environ.get("HYLC_SHARED", "../shared")
 PATTERNS = ["basket", "satin", "slip_stitch_honeycomb", "stockinette", "cartridge_belt_rib"]
 # neighbouring strains with the spacing of a default 150-sample 1D range of the original grid (s_x, s_y in
@@ -29,6 +30,7 @@ def run(pattern, strains, cold):
         args += ["--z", z]
     if cold:
         args.append("--cold")
+    args += EXTRA
     out = subprocess.run(args, capture_output=True, text=True)
     return [json.loads(line) for line in out.stdout.splitlines() if line.startswith("{")]
 
@@ -41,6 +43,7 @@ def main():
           "| cold time per solve (ms, mean) | converged | time share warm: assembly / contact / factorisation / "
           "line search |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+    all_warm, all_cold = [], []
     for p in PATTERNS:
         for name, chain in CHAINS.items():
             warm = run(p, chain, cold=False)[1:]  # the first solve of a chain is cold
@@ -48,6 +51,8 @@ def main():
             ok = sum(r["status"] == "Converged" for r in warm + cold)
             ws = [r["steps"] for r in warm]
             cs = [r["steps"] for r in cold]
+            all_warm += ws
+            all_cold += cs
             wt = sum(r["time"] for r in warm) / len(warm) * 1e3
             ct = sum(r["time"] for r in cold) / len(cold) * 1e3
             tot = {k: sum(r["timings"][k] for r in warm) for k in ["assembly", "contact", "factorization", "line_search"]}
@@ -55,6 +60,11 @@ def main():
             share = " / ".join(f"{100 * tot[k] / s:.0f} %" for k in ["assembly", "contact", "factorization", "line_search"])
             print(f"| {p} | {name} | {statistics.median(ws):g} / {max(ws)} | {wt:.1f} | {statistics.median(cs):g} / "
                   f"{max(cs)} | {ct:.1f} | {ok}/{len(warm) + len(cold)} | {share} |")
+
+
+    print()
+    print(f"all chains: warm median {statistics.median(all_warm):g} steps over {len(all_warm)} solves, "
+          f"cold median {statistics.median(all_cold):g} over {len(all_cold)}")
 
 
 if __name__ == "__main__":

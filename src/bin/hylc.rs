@@ -109,6 +109,9 @@ enum Command {
         /// start every strain from the reference state
         #[arg(long)]
         cold: bool,
+        /// warm start from the previous solution only (no secant extrapolation along the chain)
+        #[arg(long)]
+        no_predictor: bool,
         /// force tolerance relative to the stretching stiffness
         #[arg(long, default_value_t = 1e-8)]
         tolerance: f64,
@@ -121,6 +124,9 @@ enum Command {
         /// displacement limit factor (times r λ_min(I))
         #[arg(long, default_value_t = 1.0)]
         step_factor: f64,
+        /// line-search backtracking factor (trial steps factor^i down to 1e-10)
+        #[arg(long, default_value_t = 0.1)]
+        backtracking: f64,
         /// no per-yarn slide constraints
         #[arg(long)]
         no_slide_constraints: bool,
@@ -250,10 +256,12 @@ fn main() -> ExitCode {
             pattern,
             z,
             cold,
+            no_predictor,
             tolerance,
             max_steps,
             time_limit,
             step_factor,
+            backtracking,
             no_slide_constraints,
             obj,
             json,
@@ -265,10 +273,20 @@ fn main() -> ExitCode {
                 max_steps,
                 time_limit,
                 step_factor,
+                backtracking,
                 slide_constraints: !no_slide_constraints,
                 ..Default::default()
             };
-            micro::solve(&pattern, &z, cold, options, obj.as_deref(), json).map(|ok| {
+            micro::solve(
+                &pattern,
+                &z,
+                cold,
+                !no_predictor,
+                options,
+                obj.as_deref(),
+                json,
+            )
+            .map(|ok| {
                 if ok {
                     ExitCode::SUCCESS
                 } else {

@@ -44,6 +44,9 @@ pub struct SolverOptions {
     pub step_factor: f64,
     /// Constrain each yarn's slide along itself (the original allowed switching it off).
     pub slide_constraints: bool,
+    /// Backtracking factor of the line search: trial steps factorⁱ down to 1e-10 (the design's 0.1ⁱ, i ≤ 10,
+    /// is `0.1`).
+    pub backtracking: f64,
     /// Broad-phase margin in units of r.
     pub contact_margin: f64,
     /// Print one line per Newton step to stderr (energy, ‖g‖∞, decrement, μ, step length).
@@ -59,6 +62,7 @@ impl Default for SolverOptions {
             time_limit: None,
             step_factor: 1.0,
             slide_constraints: true,
+            backtracking: 0.1,
             contact_margin: crate::tile::contact::DEFAULT_MARGIN,
             trace: false,
         }
@@ -356,6 +360,62 @@ impl MicroProblem {
         state.family = family;
     }
 
+    /// A secant predictor for continuation along a chain of strains: from the equilibria `prev` at z₀ and `cur`
+    /// at z₁ (same family), the state at `target` with y extrapolated linearly, y₁ + (y₁ − y₀)·t, where t is the
+    /// projection of target − z₁ on z₁ − z₀ relative to |z₁ − z₀|² (strain components weighted 1, curvatures by
+    /// the larger period). Returns `None` when the families differ or the step is degenerate; the frames are
+    /// transported to the predicted state.
+    pub fn predict(
+        &self,
+        prev: &MicroState,
+        cur: &MicroState,
+        target: &MacroStrain,
+    ) -> Result<Option<MicroState>, StrainError> {
+        let family = target.validate()?;
+        if prev.family != cur.family || cur.family != family {
+            return Ok(None);
+        }
+        let pmax = self.pattern.periods[0].max(self.pattern.periods[1]);
+        let w = |k: usize| if k < 3 { 1.0 } else { pmax };
+        let d1: Vec<f64> = (0..5)
+            .map(|k| (cur.strain.0[k] - prev.strain.0[k]) * w(k))
+            .collect();
+        let d2: Vec<f64> = (0..5)
+            .map(|k| (target.0[k] - cur.strain.0[k]) * w(k))
+            .collect();
+        let n1: f64 = d1.iter().map(|v| v * v).sum();
+        if n1 <= 0.0 {
+            return Ok(None);
+        }
+        let t = d1.iter().zip(&d2).map(|(a, b)| a * b).sum::<f64>() / n1;
+        if !(t > 0.0 && t <= 2.0) {
+            return Ok(None);
+        }
+        let mut state = cur.clone();
+        self.move_to(&mut state, target)?;
+        let y: Vec<f64> = cur
+            .y
+            .iter()
+            .zip(&prev.y)
+            .map(|(a, b)| a + t * (a - b))
+            .collect();
+        let n = self.pattern.len();
+        let elim = Elimination::in_family(&self.pattern, target, family);
+        let positions: Vec<Vector3<f64>> = (0..n)
+            .map(|v| elim.position(v, [0, 0], &local(&y, v)))
+            .collect();
+        let theta = y[3 * n..].to_vec();
+        state.frames.advance(
+            &self.pattern,
+            &self.topology,
+            positions,
+            theta,
+            &elim.transforms,
+        );
+        state.y = y;
+        Ok(Some(state))
+    }
+
     /// Solve at `strain`, starting from `start` (the reference state when `None`).
     pub fn solve(
         &self,
@@ -521,7 +581,9 @@ impl MicroProblem {
             let tl = Instant::now();
             let mut accepted = false;
             let mut step = 1.0;
-            for _ in 0..=10 {
+            let factor = opts.backtracking;
+            let trials = (1e-10f64.ln() / factor.ln()).ceil() as usize;
+            for _ in 0..=trials {
                 let trial: Vec<f64> = state
                     .y
                     .iter()
@@ -559,7 +621,7 @@ impl MicroProblem {
                     accepted = true;
                     break;
                 }
-                step *= 0.1;
+                step *= factor;
             }
             timings.line_search += tl.elapsed().as_secs_f64();
             if opts.trace {

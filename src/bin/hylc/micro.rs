@@ -78,6 +78,7 @@ pub fn solve(
     pattern: &str,
     z: &[String],
     cold: bool,
+    predictor: bool,
     options: SolverOptions,
     obj: Option<&Path>,
     json_out: bool,
@@ -93,11 +94,21 @@ pub fn solve(
     };
     let mut all_ok = true;
     let mut prev: Option<Solution> = None;
+    let mut before: Option<Solution> = None;
     for (k, strain) in strains.iter().enumerate() {
+        // warm start from the previous solution, extrapolated along the chain when two are available
+        let predicted = match (&before, &prev) {
+            (Some(a), Some(b)) if !cold && predictor && a.psi().is_ok() && b.psi().is_ok() => {
+                problem
+                    .predict(&a.state, &b.state, strain)
+                    .map_err(|e| e.to_string())?
+            }
+            _ => None,
+        };
         let start = if cold {
             None
         } else {
-            prev.as_ref().map(|s| &s.state)
+            predicted.as_ref().or(prev.as_ref().map(|s| &s.state))
         };
         let sol = problem.solve(strain, start).map_err(|e| e.to_string())?;
         let r = report(&problem, &sol);
@@ -142,6 +153,7 @@ pub fn solve(
             };
             write_obj(&problem, &sol, &path)?;
         }
+        before = prev.take();
         prev = Some(sol);
     }
     Ok(all_ok)
