@@ -231,6 +231,29 @@ impl MicroProblem {
         &self.constraints
     }
 
+    /// Replace the constraint rows (each of length 4n over the unknowns y = (ũ, θ); normalised here), e.g. to pin
+    /// one vertex per yarn along its axis as the original solver did. The rows must be independent and, together
+    /// with H, leave no free rigid mode.
+    pub fn with_constraints(mut self, rows: Vec<Vec<f64>>) -> Result<Self, String> {
+        let nd = 4 * self.pattern.len();
+        let mut rows = rows;
+        for (k, row) in rows.iter_mut().enumerate() {
+            if row.len() != nd {
+                return Err(format!(
+                    "constraint row {k} has {} entries, expected {nd}",
+                    row.len()
+                ));
+            }
+            let norm = row.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if !(norm.is_finite() && norm > 0.0) {
+                return Err(format!("constraint row {k} is zero or not finite"));
+            }
+            row.iter_mut().for_each(|v| *v /= norm);
+        }
+        self.constraints = rows;
+        Ok(self)
+    }
+
     /// Euclidean projection of a (scaled) gradient on the null space of A: g − Aᵀ (A Aᵀ)⁻¹ A g.
     pub fn project(&self, g: &[f64]) -> Vec<f64> {
         let a = &self.constraints;
