@@ -9,6 +9,7 @@ pub mod diff;
 pub mod material;
 pub mod pattern;
 pub mod rod;
+pub mod shell;
 pub mod tile;
 
 use std::path::PathBuf;

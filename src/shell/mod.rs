@@ -1,0 +1,14 @@
+//! Macro scale: a triangle-mesh thin shell with the homogenized energy A·ψ(z(q)) per triangle, simulated by
+//! implicit Euler as incremental-potential minimisation (`../shared/design/05-macro.md`, Algorithm C8).
+//!
+//! Data flow, one file per stage: [`strain`] (the strain chain z(q) of a triangle stencil) → [`element`]
+//! (triangle energy, gradient, Hessian, PSD options) → [`mesh`] (rectangles, OBJ, stencils) → [`assemble`]
+//! (parallel assembly into a fixed sparsity pattern) → [`solver`] (implicit Euler, quasi-static, boundary
+//! conditions, obstacles, faer sparse Cholesky) → [`scene`] (JSON scenes and the built-ins). [`checks`] puts the
+//! strain chain, the triangle energy and the assembled energy under the derivative harness.
+//!
+//! Out of scope: remeshing and cloth self-collision.
+
+pub mod strain;
+
+pub use strain::{strain, strain_reference, RestTriangle, StrainChain};
