@@ -38,7 +38,12 @@ fn strain_chain_matches_the_original() {
             for j in 0..18 {
                 // a missing flap is stored as the origin: leave it there (it does not enter)
                 let flap = j / 3 >= 3 && !flaps[j / 3 - 3];
-                q[j] = xloc[j] + if flap { 0.0 } else { shift * [1.0, -0.6, 0.8][j % 3] };
+                q[j] = xloc[j]
+                    + if flap {
+                        0.0
+                    } else {
+                        shift * [1.0, -0.6, 0.8][j % 3]
+                    };
             }
             let chain = StrainChain::new(&q, &rest, flaps).expect("non-degenerate case");
             let mut z = chain.z;
@@ -71,5 +76,10 @@ fn strain_chain_matches_the_original() {
         "strain oracle, 300 cases at the origin and 2 m away: max rel err value {:.2e}, Jacobian {:.2e}, Hessian {:.2e}",
         worst[0], worst[1], worst[2]
     );
-    assert!(failures.is_empty(), "{} cases off:\n{}", failures.len(), failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} cases off:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
 }

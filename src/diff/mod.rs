@@ -333,6 +333,7 @@ pub fn registry() -> Vec<Box<dyn Check>> {
     checks.extend(crate::rod::diff_checks());
     checks.extend(crate::contact::diff_checks());
     checks.extend(crate::tile::diff_checks());
+    checks.extend(crate::shell::diff_checks());
     checks
 }
 

@@ -12,3 +12,23 @@
 pub mod strain;
 
 pub use strain::{strain, strain_reference, RestTriangle, StrainChain};
+pub mod assemble;
+pub mod checks;
+pub mod element;
+pub mod mesh;
+
+pub use checks::diff_checks;
+pub use element::{ElementModel, ModelFlags, Psd};
+pub use mesh::{Mesh, Stencil};
+
+/// An error of the macro scale: one sentence naming the file, line or field at fault.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ShellError(pub String);
+
+impl std::fmt::Display for ShellError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for ShellError {}

@@ -42,7 +42,10 @@ impl RestTriangle {
     /// From rest positions in the fabric plane (warp/weft coordinates). `None` for a degenerate (zero-area or
     /// non-finite) triangle.
     pub fn new(x0: [f64; 2], x1: [f64; 2], x2: [f64; 2]) -> Option<Self> {
-        let (a, b) = ([x1[0] - x0[0], x1[1] - x0[1]], [x2[0] - x0[0], x2[1] - x0[1]]);
+        let (a, b) = (
+            [x1[0] - x0[0], x1[1] - x0[1]],
+            [x2[0] - x0[0], x2[1] - x0[1]],
+        );
         let det = a[0] * b[1] - b[0] * a[1];
         let scale = (a[0].hypot(a[1])) * (b[0].hypot(b[1]));
         if !det.is_finite() || !(det.abs() > 1e-14 * scale) {
@@ -68,11 +71,7 @@ impl RestTriangle {
     #[inline]
     pub fn r(&self) -> [[f64; 2]; 3] {
         let d = &self.inv_dm;
-        [
-            d[1],
-            [d[0][0] + d[1][0], d[0][1] + d[1][1]],
-            d[0],
-        ]
+        [d[1], [d[0][0] + d[1][0], d[0][1] + d[1][1]], d[0]]
     }
 
     /// Coefficients of II₀₀, II₀₁, II₁₁ in κ_i for each edge: (r_i0², r_i0 r_i1, r_i1²).
@@ -136,10 +135,10 @@ pub struct StrainChain {
     hinges: [Option<Hinge>; 3],
 }
 
-/// The angle θ of a hinge from its edge vectors (e = p₁−p₀, a = p₂−p₀, b = p₃−p₀).
+/// The angle θ of a hinge from the triangle normal n₀ = (x₁−x₀)×(x₂−x₀) (computed once per triangle, exactly as
+/// the note defines it, so that every hinge sees the same n₀), its edge vector e and b = p₃ − p₀.
 #[inline]
-fn hinge_angle(e: &V3, a: &V3, b: &V3) -> f64 {
-    let n0 = e.cross(a);
+fn hinge_angle(e: &V3, n0: &V3, b: &V3) -> f64 {
     let n1 = b.cross(e);
     let y = e.dot(&n0.cross(&n1)) / e.norm();
     -y.atan2(n0.dot(&n1))
@@ -164,21 +163,29 @@ fn in_plane(q: &[f64; NDOF], rest: &RestTriangle) -> Option<([V3; 2], [f64; 2])>
 /// edge, zero area, non-finite input).
 pub fn strain(q: &[f64; NDOF], rest: &RestTriangle, flaps: [bool; 3]) -> Option<[f64; 6]> {
     let (f, n) = in_plane(q, rest)?;
-    let mut z = [n[0] - 1.0, f[0].dot(&f[1]) / (n[0] * n[1]), n[1] - 1.0, 0.0, 0.0, 0.0];
+    let mut z = [
+        n[0] - 1.0,
+        f[0].dot(&f[1]) / (n[0] * n[1]),
+        n[1] - 1.0,
+        0.0,
+        0.0,
+        0.0,
+    ];
     let coef = rest.bend_coeffs();
+    let n0 = (vtx(q, 1) - vtx(q, 0)).cross(&(vtx(q, 2) - vtx(q, 0)));
+    let na = n0.norm();
     for i in 0..3 {
         if !flaps[i] {
             continue;
         }
-        let [p0, p1, p2, p3] = hinge(i);
+        let [p0, p1, _, p3] = hinge(i);
         let x0 = vtx(q, p0);
-        let (e, a, b) = (vtx(q, p1) - x0, vtx(q, p2) - x0, vtx(q, p3) - x0);
+        let (e, b) = (vtx(q, p1) - x0, vtx(q, p3) - x0);
         let le = e.norm();
-        let na = e.cross(&a).norm();
         if !(le > 0.0 && na > 0.0) {
             return None;
         }
-        let kappa = hinge_angle(&e, &a, &b) * na / le;
+        let kappa = hinge_angle(&e, &n0, &b) * na / le;
         if !kappa.is_finite() {
             return None;
         }
@@ -209,21 +216,25 @@ impl StrainChain {
         }
         let coef = rest.bend_coeffs();
         let mut hinges = [None; 3];
+        let na_v = (vtx(q, 1) - vtx(q, 0)).cross(&(vtx(q, 2) - vtx(q, 0)));
         for i in 0..3 {
             if !flaps[i] {
                 continue;
             }
             let idx = hinge(i);
             let x0 = vtx(q, idx[0]);
-            let (e, a, b) = (vtx(q, idx[1]) - x0, vtx(q, idx[2]) - x0, vtx(q, idx[3]) - x0);
+            let (e, a, b) = (
+                vtx(q, idx[1]) - x0,
+                vtx(q, idx[2]) - x0,
+                vtx(q, idx[3]) - x0,
+            );
             let le = e.norm();
-            let na_v = e.cross(&a);
             let nb_v = e.cross(&b);
             let (na, nb) = (na_v.norm(), nb_v.norm());
             if !(le > 0.0 && na > 0.0 && nb > 0.0) {
                 return None;
             }
-            let theta = hinge_angle(&e, &a, &b);
+            let theta = hinge_angle(&e, &na_v, &b);
             let h = na / le;
             // θ gradient
             let ga = na_v * (le / (na * na));
@@ -359,7 +370,11 @@ fn add_hinge_hessian(hg: &Hinge, omega: f64, idx: [usize; 4], out: &mut [[f64; N
         let (g, dge, dgw, t, te, tw) = wing(&hg.e, w);
         let k1e = g * te.transpose() + dge * t;
         let k1w = g * tw.transpose() + dgw * t;
-        let rows = [(0usize, dge - k1e, dgw - k1w), (1, k1e, k1w), (pw, -dge, -dgw)];
+        let rows = [
+            (0usize, dge - k1e, dgw - k1w),
+            (1, k1e, k1w),
+            (pw, -dge, -dgw),
+        ];
         for (r, ke, kw) in rows {
             // columns: ∂/∂p₁ = ∂/∂e, ∂/∂p_w = ∂/∂w, ∂/∂p₀ = −∂/∂e − ∂/∂w
             let ke = ke * (sign * hg.h * omega);
