@@ -16,6 +16,8 @@ pub mod assemble;
 pub mod checks;
 pub mod element;
 pub mod mesh;
+pub mod scene;
+pub mod solver;
 
 pub use checks::diff_checks;
 pub use element::{ElementModel, ModelFlags, Psd};
