@@ -484,6 +484,29 @@ impl Simulation {
         })
     }
 
+    /// The first Newton direction of the next step at the current state (assembly, factorisation, solve): one
+    /// Newton iteration without the line search, for benchmarks. Returns the direction and the shift used.
+    pub fn newton_direction(&self) -> Result<(Vec<f64>, f64), ShellError> {
+        let h = self.settings.dt;
+        let xt: Vec<f64> = if self.settings.quasi_static {
+            self.x.clone()
+        } else {
+            self.x.iter().zip(&self.v).map(|(x, v)| x + h * v).collect()
+        };
+        let tg = Target {
+            xt,
+            xn: self.x.clone(),
+        };
+        let (asm, g) = self.gradient_hessian(&self.x, &tg)?;
+        let mut gf = vec![0.0; 3 * self.pattern.nfree];
+        for v in 0..self.pattern.n {
+            if let Some(k) = self.pattern.free[v] {
+                gf[3 * k..3 * k + 3].copy_from_slice(&g[3 * v..3 * v + 3]);
+            }
+        }
+        self.solve(&asm.values, &gf)
+    }
+
     /// Assembled elastic terms plus the external ones: (assembly with the full Hessian values, full gradient
     /// of Φ including constrained vertices — with their inertia — for the reaction forces).
     fn gradient_hessian(
