@@ -11,7 +11,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use hylc::material::synthetic::default_material;
 use hylc::material::Material;
 use hylc::shell::checks::sample_stencil;
-use hylc::shell::solver::{Settings, Simulation};
+use hylc::shell::solver::{Boundary, Settings, Simulation};
 use hylc::shell::{ElementModel, Mesh, ModelFlags, Psd};
 use rand::SeedableRng;
 use std::hint::black_box;
@@ -84,9 +84,10 @@ fn simulation(nt: usize) -> Simulation {
         model,
         stencils,
         x0,
-        vec![0],
-        vec![],
-        vec![],
+        Boundary {
+            pinned: vec![0],
+            ..Boundary::default()
+        },
         Settings::default(),
         1.0,
     )

@@ -6,7 +6,7 @@ mod common;
 use hylc::material::synthetic::default_material;
 use hylc::shell::assemble::energy;
 use hylc::shell::scene::Scene;
-use hylc::shell::solver::{Handle, Settings, Simulation};
+use hylc::shell::solver::{Boundary, Handle, Settings, Simulation};
 use hylc::shell::{ElementModel, Mesh, ModelFlags, Psd};
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 use rand::{Rng, SeedableRng};
@@ -226,9 +226,10 @@ fn uniaxial_strip(material: &hylc::material::Material, name: &str) {
         model(),
         st.clone(),
         x0,
-        vec![],
-        handles,
-        vec![],
+        Boundary {
+            handles,
+            ..Boundary::default()
+        },
         settings,
         1.0,
     )

@@ -182,6 +182,15 @@ pub fn assemble(
     x: &[f64],
     hessian: bool,
 ) -> Option<Assembled> {
+    if stencils.is_empty() {
+        return Some(Assembled {
+            energy: 0.0,
+            grad: vec![0.0; x.len()],
+            values: vec![0.0; if hessian { pattern.nnz() } else { 0 }],
+            zmin: [0.0; 6],
+            zmax: [0.0; 6],
+        });
+    }
     let nthreads = rayon::current_num_threads().max(1);
     let chunk = stencils.len().div_ceil(nthreads).max(1);
     let nnz = if hessian { pattern.nnz() } else { 0 };

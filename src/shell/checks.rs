@@ -269,7 +269,7 @@ impl Differentiable for StrainCheck {
     }
     fn sample(&self, rng: &mut ChaCha8Rng, i: usize) -> Vec<f64> {
         let (q, rest, flaps) = sample_stencil(rng, i);
-        let w: [f64; 6] = if i % 7 < 6 && i % 2 == 0 {
+        let w: [f64; 6] = if i % 7 < 6 && i.is_multiple_of(2) {
             std::array::from_fn(|k| if k == i % 7 { 1.0 } else { 0.0 })
         } else {
             std::array::from_fn(|_| rng.random_range(-1.0..1.0))
@@ -498,9 +498,9 @@ impl Differentiable for MeshCheck {
         let sh = rng.random_range(-0.4..0.4);
         let k1 = rng.random_range(-40.0..40.0);
         let k2 = rng.random_range(-40.0..40.0);
-        let noise = if i % 2 == 0 { 0.0005 } else { 0.002 };
+        let noise = if i.is_multiple_of(2) { 0.0005 } else { 0.002 };
         let rot = random_rotation(rng);
-        let shift = if i % 3 == 0 { 2.0 } else { 0.0 };
+        let shift = if i.is_multiple_of(3) { 2.0 } else { 0.0 };
         let mut x = Vec::with_capacity(self.dim());
         for p in &self.rest {
             let u = sx * p[0] + sh * p[1];

@@ -240,7 +240,7 @@ fn project6(h: &mut [[f64; 6]; 6]) {
     }
     let l = eig.eigenvalues.map(|l| l.max(0.0));
     let r =
-        &eig.eigenvectors * SMatrix::<f64, 6, 6>::from_diagonal(&l) * eig.eigenvectors.transpose();
+        eig.eigenvectors * SMatrix::<f64, 6, 6>::from_diagonal(&l) * eig.eigenvectors.transpose();
     for i in 0..6 {
         for j in 0..6 {
             h[i][j] = r[(i, j)];
@@ -295,7 +295,7 @@ fn cholesky_above_minus_floor(m: &SMatrix<f64, NDOF, NDOF>, live: &[usize]) -> b
                 s -= l[a][k] * l[b][k];
             }
             if a == b {
-                if !(s > 0.0) {
+                if s.is_nan() || s <= 0.0 {
                     return false;
                 }
                 l[a][a] = s.sqrt();

@@ -91,6 +91,15 @@ impl Handle {
     }
 }
 
+/// Boundary conditions and obstacles of a simulation.
+#[derive(Clone, Debug, Default)]
+pub struct Boundary {
+    /// vertices held at their initial positions
+    pub pinned: Vec<usize>,
+    pub handles: Vec<Handle>,
+    pub obstacles: Vec<Obstacle>,
+}
+
 /// Solver settings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
@@ -182,12 +191,15 @@ impl Simulation {
         model: ElementModel,
         stencils: Vec<Stencil>,
         x0: Vec<[f64; 3]>,
-        pinned: Vec<usize>,
-        handles: Vec<Handle>,
-        obstacles: Vec<Obstacle>,
+        boundary: Boundary,
         settings: Settings,
         mass_multiplier: f64,
     ) -> Result<Simulation, ShellError> {
+        let Boundary {
+            pinned,
+            handles,
+            obstacles,
+        } = boundary;
         let n = x0.len();
         if !(settings.dt > 0.0 && settings.dt.is_finite()) {
             return Err(ShellError(format!(
@@ -214,7 +226,7 @@ impl Simulation {
                 mass[s.v[a]] += rho * s.rest.area / 3.0;
             }
         }
-        if !settings.quasi_static && mass.iter().any(|&m| !(m > 0.0)) {
+        if !settings.quasi_static && mass.iter().any(|&m| m.is_nan() || m <= 0.0) {
             return Err(ShellError(
                 "every vertex needs a positive mass (material density, mass multiplier, unused vertices?)"
                     .into(),

@@ -48,7 +48,7 @@ impl RestTriangle {
         );
         let det = a[0] * b[1] - b[0] * a[1];
         let scale = (a[0].hypot(a[1])) * (b[0].hypot(b[1]));
-        if !det.is_finite() || !(det.abs() > 1e-14 * scale) {
+        if !det.is_finite() || det.abs() <= 1e-14 * scale || scale.is_nan() {
             return None;
         }
         let inv = 1.0 / det;
