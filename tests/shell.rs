@@ -393,3 +393,94 @@ fn builtin_scenes_round_trip_and_a_short_run_is_stable() {
     assert!(r.energy_gravity < 0.0 && r.energy_elastic > 0.0);
     assert!(sim.x.iter().all(|v| v.is_finite()));
 }
+
+/// The harness catches the bug this code once had: the dihedral-angle gradient of the triangle's own wing with
+/// the wrong sign (here: the Jacobian and Hessian entries of the flap vertices negated), and a 1e-6 relative
+/// error in the weighted Hessian.
+#[test]
+fn harness_catches_strain_chain_mutants() {
+    use hylc::diff::{check_function, CheckConfig, Differentiable, Real, Vgh};
+    use hylc::shell::checks::StrainCheck;
+    struct Mutant(usize);
+    impl Differentiable for Mutant {
+        fn name(&self) -> String {
+            format!("mutant {}", self.0)
+        }
+        fn dim(&self) -> usize {
+            StrainCheck.dim()
+        }
+        fn n_params(&self) -> usize {
+            StrainCheck.n_params()
+        }
+        fn scales_at(&self, x: &[f64]) -> hylc::diff::Scales {
+            StrainCheck.scales_at(x)
+        }
+        fn input_scale_at(&self, x: &[f64], i: usize) -> f64 {
+            StrainCheck.input_scale_at(x, i)
+        }
+        fn reference<D: Real>(&self, x: &[D]) -> D {
+            StrainCheck.reference(x)
+        }
+        fn fast(&self, x: &[f64]) -> Vgh {
+            let mut v = StrainCheck.fast(x);
+            if self.0 == 0 {
+                for j in 9..18 {
+                    v.gradient[j] = -v.gradient[j];
+                    for k in 0..18 {
+                        v.hessian[(j, k)] = -v.hessian[(j, k)];
+                        v.hessian[(k, j)] = -v.hessian[(k, j)];
+                    }
+                }
+            } else {
+                v.hessian *= 1.0 + 1e-6;
+            }
+            v
+        }
+        fn fast_value(&self, x: &[f64]) -> f64 {
+            StrainCheck.fast_value(x)
+        }
+        fn sample(&self, rng: &mut ChaCha8Rng, i: usize) -> Vec<f64> {
+            // bending weights only, so the mutated entries matter
+            let mut x = StrainCheck.sample(rng, i);
+            let n = x.len();
+            for k in 0..3 {
+                x[n - 6 + k] = 0.0;
+                x[n - 3 + k] = rng.random_range(0.5..1.0);
+            }
+            x
+        }
+    }
+    let cfg = CheckConfig { cases: 50, ..CheckConfig::default() };
+    for m in [Mutant(0), Mutant(1)] {
+        let r = check_function(&m, &cfg);
+        assert!(!r.passed(), "{} passed: worst ratio {}", m.name(), r.worst_ratio);
+    }
+    assert!(check_function(&StrainCheck, &cfg).passed());
+}
+
+/// Zero strain in the rest configuration (the rest layout in material coordinates, rigidly moved; flaps flat).
+#[test]
+fn rest_configuration_has_zero_strain() {
+    let mesh = Mesh::rectangle(0.04, 0.03, 0.005, 0.3, 9).unwrap();
+    let angle = 0.7;
+    let st = mesh.stencils(angle).unwrap();
+    let xm = material_coords(&mesh, angle);
+    let rot = Rotation3::from_axis_angle(&Unit::new_normalize(Vector3::new(1.0, 2.0, -0.5)), 2.0);
+    let x: Vec<f64> = xm
+        .iter()
+        .flat_map(|p| {
+            let q = rot * Vector3::new(p[0], p[1], 0.0) + Vector3::new(0.3, 0.1, -0.2);
+            [q[0], q[1], q[2]]
+        })
+        .collect();
+    let m = model();
+    for s in &st {
+        let z = m.strain(&hylc::shell::assemble::gather(s, &x), &s.rest, s.flaps).unwrap();
+        for k in 0..3 {
+            assert!(z[k].abs() <= 1e-13, "{z:?}");
+        }
+        for k in 3..6 {
+            assert!(z[k].abs() <= 1e-9, "{z:?}");
+        }
+    }
+}
