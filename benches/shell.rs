@@ -111,6 +111,7 @@ fn newton(c: &mut Criterion) {
                     &sim.pattern,
                     &sim.x,
                     true,
+                    false,
                 ))
             })
         });

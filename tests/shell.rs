@@ -450,10 +450,18 @@ fn harness_catches_strain_chain_mutants() {
             x
         }
     }
-    let cfg = CheckConfig { cases: 50, ..CheckConfig::default() };
+    let cfg = CheckConfig {
+        cases: 50,
+        ..CheckConfig::default()
+    };
     for m in [Mutant(0), Mutant(1)] {
         let r = check_function(&m, &cfg);
-        assert!(!r.passed(), "{} passed: worst ratio {}", m.name(), r.worst_ratio);
+        assert!(
+            !r.passed(),
+            "{} passed: worst ratio {}",
+            m.name(),
+            r.worst_ratio
+        );
     }
     assert!(check_function(&StrainCheck, &cfg).passed());
 }
@@ -475,7 +483,9 @@ fn rest_configuration_has_zero_strain() {
         .collect();
     let m = model();
     for s in &st {
-        let z = m.strain(&hylc::shell::assemble::gather(s, &x), &s.rest, s.flaps).unwrap();
+        let z = m
+            .strain(&hylc::shell::assemble::gather(s, &x), &s.rest, s.flaps)
+            .unwrap();
         for k in 0..3 {
             assert!(z[k].abs() <= 1e-13, "{z:?}");
         }

@@ -157,8 +157,10 @@ pub struct Assembled {
     pub energy: f64,
     /// gradient over all 3n dofs (constrained ones included, for reaction forces)
     pub grad: Vec<f64>,
-    /// Hessian values in the pattern's order (empty when not requested)
+    /// Hessian values in the pattern's order, with the model's PSD option (empty when not requested)
     pub values: Vec<f64>,
+    /// exact Hessian values (only when requested with `exact_too`)
+    pub values_exact: Vec<f64>,
     /// componentwise min and max of z over the mesh
     pub zmin: [f64; 6],
     pub zmax: [f64; 6],
@@ -173,20 +175,23 @@ pub fn energy(model: &ElementModel, stencils: &[Stencil], x: &[f64]) -> Option<f
         .try_reduce(|| 0.0, |a, b| Some(a + b))
 }
 
-/// Energy, gradient and (if `hessian`) the free-dof Hessian of the elastic energy; `None` if any triangle is
-/// degenerate.
+/// Energy, gradient and (if `hessian`) the free-dof Hessian of the elastic energy with the model's PSD option,
+/// and with `exact_too` also the exact Hessian (same evaluation); `None` if any triangle is degenerate.
 pub fn assemble(
     model: &ElementModel,
     stencils: &[Stencil],
     pattern: &Pattern,
     x: &[f64],
     hessian: bool,
+    exact_too: bool,
 ) -> Option<Assembled> {
+    let exact_too = hessian && exact_too;
     if stencils.is_empty() {
         return Some(Assembled {
             energy: 0.0,
             grad: vec![0.0; x.len()],
             values: vec![0.0; if hessian { pattern.nnz() } else { 0 }],
+            values_exact: vec![0.0; if exact_too { pattern.nnz() } else { 0 }],
             zmin: [0.0; 6],
             zmax: [0.0; 6],
         });
@@ -202,14 +207,18 @@ pub fn assemble(
                 energy: 0.0,
                 grad: vec![0.0; x.len()],
                 values: vec![0.0; nnz],
+                values_exact: vec![0.0; if exact_too { nnz } else { 0 }],
                 zmin: [f64::INFINITY; 6],
                 zmax: [f64::NEG_INFINITY; 6],
             };
             let mut g = [0.0; NDOF];
             let mut h = [[0.0; NDOF]; NDOF];
+            let mut hx = [[0.0; NDOF]; NDOF];
             for (si, s) in ss.iter().enumerate() {
                 let q = gather(s, x);
-                let (e, z) = if hessian {
+                let (e, z) = if exact_too {
+                    model.energy_gradient_hessians(&q, &s.rest, s.flaps, &mut g, &mut hx, &mut h)?
+                } else if hessian {
                     model.energy_gradient_hessian(&q, &s.rest, s.flaps, &mut g, &mut h)?
                 } else {
                     model.energy_gradient(&q, &s.rest, s.flaps, &mut g)?
@@ -242,6 +251,12 @@ pub fn assemble(
                                 for r in r0..3 {
                                     out.values[start + r - r0] += h[3 * a + r][3 * b + c];
                                 }
+                                if exact_too {
+                                    for r in r0..3 {
+                                        out.values_exact[start + r - r0] +=
+                                            hx[3 * a + r][3 * b + c];
+                                    }
+                                }
                             }
                         }
                     }
@@ -263,6 +278,11 @@ pub fn assemble(
             .values
             .par_iter_mut()
             .zip(p.values.par_iter())
+            .for_each(|(a, b)| *a += b);
+        total
+            .values_exact
+            .par_iter_mut()
+            .zip(p.values_exact.par_iter())
             .for_each(|(a, b)| *a += b);
         for k in 0..6 {
             total.zmin[k] = total.zmin[k].min(p.zmin[k]);

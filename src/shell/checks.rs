@@ -465,7 +465,8 @@ impl Differentiable for MeshCheck {
     }
     fn fast(&self, x: &[f64]) -> Vgh {
         let n = self.dim();
-        match super::assemble::assemble(&self.model, &self.stencils, &self.pattern, x, true) {
+        match super::assemble::assemble(&self.model, &self.stencils, &self.pattern, x, true, false)
+        {
             Some(a) => {
                 let mut h = DMatrix::zeros(n, n);
                 for c in 0..n {

@@ -176,6 +176,52 @@ impl ElementModel {
         for j in 0..NDOF {
             grad[j] = (0..6).map(|k| w[k] * jac[k][j]).sum();
         }
+        self.hessian_into(&ch, &p, c, &w, self.psd, hess);
+        let e = c * p.value;
+        e.is_finite().then_some((e, ch.z))
+    }
+
+    /// E_Δ, ∇E_Δ, the exact ∇²E_Δ (`exact`) and the Hessian of the model's PSD option (`projected`; equal to
+    /// `exact` for [`Psd::None`]) from one evaluation of the strain chain and ψ.
+    pub fn energy_gradient_hessians(
+        &self,
+        q: &[f64; NDOF],
+        rest: &RestTriangle,
+        flaps: [bool; 3],
+        grad: &mut [f64; NDOF],
+        exact: &mut [[f64; NDOF]; NDOF],
+        projected: &mut [[f64; NDOF]; NDOF],
+    ) -> Option<(f64, [f64; 6])> {
+        let ch = StrainChain::new(q, rest, self.flaps(flaps))?;
+        let p = self.material.eval(&self.scaled(&ch.z));
+        let (c, w) = self.weights(rest, &p.grad);
+        for j in 0..NDOF {
+            grad[j] = (0..6).map(|k| w[k] * ch.jac[k][j]).sum();
+        }
+        self.hessian_into(&ch, &p, c, &w, Psd::None, exact);
+        match self.psd {
+            Psd::None => *projected = *exact,
+            Psd::Full => {
+                *projected = *exact;
+                project18(projected);
+            }
+            Psd::Psi => self.hessian_into(&ch, &p, c, &w, Psd::Psi, projected),
+        }
+        let e = c * p.value;
+        e.is_finite().then_some((e, ch.z))
+    }
+
+    /// The local Hessian for PSD option `psd` from the chain, ψ's derivatives, c = A k and the weights w.
+    fn hessian_into(
+        &self,
+        ch: &StrainChain,
+        p: &crate::material::PsiVgh,
+        c: f64,
+        w: &[f64; 6],
+        psd: Psd,
+        hess: &mut [[f64; NDOF]; NDOF],
+    ) {
+        let jac = &ch.jac;
         // H6 = c S ∇²ψ S (projected for option (b))
         let s = [
             1.0,
@@ -191,7 +237,7 @@ impl ElementModel {
                 h6[a][b] = c * s[a] * s[b] * p.hess[a][b];
             }
         }
-        if self.psd == Psd::Psi {
+        if psd == Psd::Psi {
             project6(&mut h6);
         }
         // T = H6 J (6×18), then Jᵀ T; columns of J that are zero (missing flaps) are skipped
@@ -216,18 +262,16 @@ impl ElementModel {
                 };
             }
         }
-        match self.psd {
+        match psd {
             Psd::Psi => {
                 let w2 = [w[0].max(0.0), 0.0, w[2].max(0.0), 0.0, 0.0, 0.0];
                 ch.add_weighted_hessian(&w2, hess);
             }
-            _ => ch.add_weighted_hessian(&w, hess),
+            _ => ch.add_weighted_hessian(w, hess),
         }
-        if self.psd == Psd::Full {
+        if psd == Psd::Full {
             project18(hess);
         }
-        let e = c * p.value;
-        e.is_finite().then_some((e, ch.z))
     }
 }
 

@@ -14,7 +14,7 @@
 //!   "model": {"bending": true, "only_1d": false, "in_plane_only": false,
 //!             "stiffness": 1.0, "bending_scale": 1.0, "mass": 1.0},
 //!   "psd": "full",                               // "full" (18×18), "psi" (6×6), "none" (diagonal shift)
-//!   "solver": {"force_tol": 1e-6, "max_newton": 50},
+//!   "solver": {"force_tol": 1e-6, "max_newton": 50, "exact_first": true},
 //!   "pins": [{"near": {"point": [0, 0], "radius": 0.01}}],
 //!   "handles": [{"name": "left", "select": {"box": {"min": [0, 0.05], "max": [0.021, 0.25]}},
 //!                "keyframes": [[0, [0, 0, 0]], [0.25, [-0.02, 0, 0]]]}],
@@ -162,10 +162,11 @@ impl Default for ModelSpec {
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct SolverSpec {
     pub force_tol: f64,
     pub max_newton: usize,
+    pub exact_first: bool,
 }
 
 impl Default for SolverSpec {
@@ -174,6 +175,7 @@ impl Default for SolverSpec {
         SolverSpec {
             force_tol: s.force_tol,
             max_newton: s.max_newton,
+            exact_first: s.exact_first,
         }
     }
 }
@@ -494,6 +496,7 @@ impl Scene {
             quasi_static: self.quasi_static,
             force_tol: self.solver.force_tol,
             max_newton: self.solver.max_newton,
+            exact_first: self.solver.exact_first,
             gravity: self.gravity,
             drag: self.drag,
             thickness: self.contact.thickness,

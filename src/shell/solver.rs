@@ -6,7 +6,10 @@
 //! (c the linear drag rate, 1/s: implicit drag force −c m v); quasi-static mode minimises E − Σ m g·x + E_obst.
 //! Newton's method with a backtracking (Armijo) line search on Φ; converged when the largest residual force on
 //! a free vertex, ‖∂Φ/∂x_v‖, is below the force tolerance. The sparse Hessian (free dofs only) is factorised by
-//! faer's sparse Cholesky with the symbolic analysis computed once per simulation; if the numeric factorisation
+//! faer's sparse Cholesky with the symbolic analysis computed once per simulation. With `exact_first` (default) the
+//! exact Hessian is factorised first and the PSD option's Hessian (`05-macro.md`, options (a)–(c)) used only when
+//! that fails (not positive definite): projected Newton far from the solution, Newton's quadratic convergence near
+//! it. If the numeric factorisation of the projected Hessian
 //! fails (an indefinite matrix, possible with [`Psd::None`](super::Psd) or in quasi-static mode) a diagonal shift
 //! μ I is added and increased tenfold until it succeeds.
 //!
@@ -111,6 +114,8 @@ pub struct Settings {
     pub force_tol: f64,
     /// Newton iterations per step at most
     pub max_newton: usize,
+    /// try the exact Hessian first and fall back to the PSD option's Hessian only when its factorisation fails
+    pub exact_first: bool,
     pub gravity: [f64; 3],
     /// linear drag rate c (1/s)
     pub drag: f64,
@@ -127,6 +132,7 @@ impl Default for Settings {
             quasi_static: false,
             force_tol: 1e-6,
             max_newton: 50,
+            exact_first: true,
             gravity: [0.0, 0.0, -9.81],
             drag: 0.0,
             thickness: 0.002,
@@ -410,7 +416,7 @@ impl Simulation {
                 break;
             }
             newton += 1;
-            let (d, shift) = self.solve(&last.values, &gf)?;
+            let (d, shift) = self.solve(&last.values, &last.values_exact, &gf)?;
             max_shift = max_shift.max(shift);
             let slope: f64 = gf.iter().zip(&d).map(|(a, b)| a * b).sum();
             let mut alpha = 1.0;
@@ -516,7 +522,7 @@ impl Simulation {
                 gf[3 * k..3 * k + 3].copy_from_slice(&g[3 * v..3 * v + 3]);
             }
         }
-        self.solve(&asm.values, &gf)
+        self.solve(&asm.values, &asm.values_exact, &gf)
     }
 
     /// Assembled elastic terms plus the external ones: (assembly with the full Hessian values, full gradient
@@ -528,13 +534,20 @@ impl Simulation {
     ) -> Result<(super::assemble::Assembled, Vec<f64>), ShellError> {
         let s = &self.settings;
         let h = s.dt;
-        let mut asm =
-            assemble(&self.model, &self.stencils, &self.pattern, x, true).ok_or_else(|| {
-                ShellError(format!(
-                    "step {}: a triangle became degenerate",
-                    self.steps + 1
-                ))
-            })?;
+        let mut asm = assemble(
+            &self.model,
+            &self.stencils,
+            &self.pattern,
+            x,
+            true,
+            self.exact_first(),
+        )
+        .ok_or_else(|| {
+            ShellError(format!(
+                "step {}: a triangle became degenerate",
+                self.steps + 1
+            ))
+        })?;
         let mut g = std::mem::take(&mut asm.grad);
         for v in 0..self.pattern.n {
             let m = self.mass[v];
@@ -551,13 +564,28 @@ impl Simulation {
             }
             if let Some(k) = self.pattern.free[v] {
                 self.pattern.add_diag_block(&mut asm.values, k, &blk);
+                if !asm.values_exact.is_empty() {
+                    self.pattern.add_diag_block(&mut asm.values_exact, k, &blk);
+                }
             }
         }
         Ok((asm, g))
     }
 
-    /// Solve H d = −g with the reused symbolic analysis; returns d and the diagonal shift used.
-    fn solve(&self, values: &[f64], g: &[f64]) -> Result<(Vec<f64>, f64), ShellError> {
+    /// Whether the assembly also produces the exact Hessian (only useful when the PSD option changes it).
+    fn exact_first(&self) -> bool {
+        self.settings.exact_first && self.model.psd != super::Psd::None
+    }
+
+    /// Solve H d = −g with the reused symbolic analysis; returns d and the diagonal shift used. With
+    /// `exact` non-empty, the exact Hessian is tried first (Newton's own direction, quadratic convergence near the
+    /// solution) and the PSD option's `values` only when the exact one is not positive definite.
+    fn solve(
+        &self,
+        values: &[f64],
+        exact: &[f64],
+        g: &[f64],
+    ) -> Result<(Vec<f64>, f64), ShellError> {
         let nf = g.len();
         let sym = SymbolicSparseColMatRef::new_checked(
             nf,
@@ -566,6 +594,16 @@ impl Simulation {
             None,
             &self.pattern.row_idx,
         );
+        if !exact.is_empty() {
+            let mat = SparseColMatRef::new(sym, exact);
+            if let Ok(llt) = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower) {
+                let mut d: Vec<f64> = g.iter().map(|x| -x).collect();
+                llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut d, nf, 1));
+                if d.iter().all(|x| x.is_finite()) {
+                    return Ok((d, 0.0));
+                }
+            }
+        }
         let mut shift = 0.0;
         let mean_diag = self
             .pattern
