@@ -10,6 +10,7 @@ pub mod material;
 pub mod micro;
 pub mod pattern;
 pub mod rod;
+pub mod shell;
 pub mod tile;
 
 use std::path::PathBuf;

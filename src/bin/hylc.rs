@@ -6,6 +6,8 @@ mod calibrate;
 mod micro;
 #[path = "hylc/micro_grid.rs"]
 mod micro_grid;
+#[path = "hylc/simulate.rs"]
+mod simulate;
 
 use clap::{Parser, Subcommand};
 use hylc::diff::{format_table, run_all, CheckConfig};
@@ -218,6 +220,42 @@ enum Command {
         #[arg(long)]
         json: Option<PathBuf>,
     },
+    /// Simulate a cloth scene: a scene JSON file or a built-in (stretch-x, stretch-y, drape-x, drape-y, hanging).
+    /// Writes frame_NNNN.obj per frame and log.jsonl (one JSON object per step) to the output folder.
+    Simulate {
+        /// scene JSON file or built-in name
+        scene: String,
+        /// output folder
+        #[arg(long, default_value = "out/simulate")]
+        out: PathBuf,
+        /// material JSON (or `default`) instead of the scene's
+        #[arg(long)]
+        material: Option<String>,
+        /// simulated time (s) instead of the scene's
+        #[arg(long)]
+        duration: Option<f64>,
+        /// edge length (m) of a rectangle mesh instead of the scene's
+        #[arg(long)]
+        edge: Option<f64>,
+        /// Hessian projection: full (18x18 eigen-projection), psi (6x6 only) or none (diagonal shift)
+        #[arg(long)]
+        psd: Option<String>,
+        /// switch bending off (II = 0; the hinges are not evaluated)
+        #[arg(long)]
+        no_bending: bool,
+        /// use only the 1D terms of the material (the original's only1D)
+        #[arg(long)]
+        only_1d: bool,
+        /// use only the in-plane terms of the material (implies no bending)
+        #[arg(long)]
+        in_plane_only: bool,
+        /// no progress bar
+        #[arg(long)]
+        quiet: bool,
+        /// print the scene (after overrides) as JSON and exit
+        #[arg(long)]
+        print: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -357,6 +395,33 @@ fn main() -> ExitCode {
             &exclusion,
             &radius_factor,
             json.as_deref(),
+        ),
+        Command::Simulate {
+            scene,
+            out,
+            material,
+            duration,
+            edge,
+            psd,
+            no_bending,
+            only_1d,
+            in_plane_only,
+            quiet,
+            print,
+        } => simulate::run_cmd(
+            &scene,
+            &out,
+            &simulate::Overrides {
+                material,
+                duration,
+                edge,
+                psd,
+                no_bending,
+                only_1d,
+                in_plane_only,
+                quiet,
+                print,
+            },
         ),
     };
     match result {

@@ -334,6 +334,7 @@ pub fn registry() -> Vec<Box<dyn Check>> {
     checks.extend(crate::contact::diff_checks());
     checks.extend(crate::tile::diff_checks());
     checks.extend(crate::micro::diff_checks());
+    checks.extend(crate::shell::diff_checks());
     checks
 }
 

@@ -1,0 +1,123 @@
+//! Macro-scale kernels (issue 6 targets: per-triangle force + Hessian ≤ 4.7 µs, ≤ 7 µs with PSD projection; time
+//! per Newton iteration growing near-linearly with the mesh size).
+//!
+//! - `triangle[<material>]/<psd>`: value, gradient and Hessian of one triangle energy (strain chain + ψ + chain
+//!   rule + projection), averaged over 64 random stencils of the derivative harness's sampler;
+//! - `newton/<triangles>`: one Newton iteration of an implicit Euler step on a 30 cm square with the default
+//!   material (parallel assembly, faer sparse Cholesky with the reused symbolic analysis, solve), and the
+//!   assembly alone.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use hylc::material::synthetic::default_material;
+use hylc::material::Material;
+use hylc::shell::checks::sample_stencil;
+use hylc::shell::solver::{Boundary, Settings, Simulation};
+use hylc::shell::{ElementModel, Mesh, ModelFlags, Psd};
+use rand::SeedableRng;
+use std::hint::black_box;
+
+fn bench_triangle(c: &mut Criterion, name: &str, m: &Material) {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    let stencils: Vec<_> = (0..64).map(|i| sample_stencil(&mut rng, 4 * i)).collect();
+    let mut g = c.benchmark_group(format!("triangle[{name}]"));
+    g.throughput(criterion::Throughput::Elements(stencils.len() as u64));
+    for (label, psd) in [
+        ("exact", Psd::None),
+        ("psd-psi6", Psd::Psi),
+        ("psd-full18", Psd::Full),
+    ] {
+        let model = ElementModel::new(m, &ModelFlags::default(), psd);
+        g.bench_function(format!("force+hessian {label}"), |b| {
+            let mut gr = [0.0; 18];
+            let mut h = [[0.0; 18]; 18];
+            b.iter(|| {
+                for (q, rest, flaps) in &stencils {
+                    black_box(model.energy_gradient_hessian(
+                        black_box(q),
+                        rest,
+                        *flaps,
+                        &mut gr,
+                        &mut h,
+                    ));
+                }
+            })
+        });
+    }
+    let model = ElementModel::new(m, &ModelFlags::default(), Psd::None);
+    g.bench_function("energy only", |b| {
+        b.iter(|| {
+            for (q, rest, flaps) in &stencils {
+                black_box(model.energy(black_box(q), rest, *flaps));
+            }
+        })
+    });
+    g.finish();
+}
+
+fn triangles(c: &mut Criterion) {
+    bench_triangle(c, "default", &default_material());
+    if let Some(dir) = hylc::shared_dir() {
+        if let Ok(m) = Material::load(&dir.join("data/hylc2020/materials/basket1.json")) {
+            bench_triangle(c, "basket1", &m);
+        }
+    }
+}
+
+/// A 30 cm square with about `nt` triangles in a smoothly stretched, bent state.
+fn simulation(nt: usize) -> Simulation {
+    let cells = ((nt as f64 / 2.0).sqrt()).round();
+    let mesh = Mesh::rectangle(0.3, 0.3, 0.3 / cells, 0.0, 1).unwrap();
+    let stencils = mesh.stencils(0.0).unwrap();
+    let x0: Vec<[f64; 3]> = mesh
+        .rest
+        .iter()
+        .map(|p| {
+            [
+                1.03 * p[0],
+                0.99 * p[1],
+                0.01 * (20.0 * p[0]).sin() * (15.0 * p[1]).cos(),
+            ]
+        })
+        .collect();
+    let model = ElementModel::new(&default_material(), &ModelFlags::default(), Psd::Full);
+    Simulation::new(
+        model,
+        stencils,
+        x0,
+        Boundary {
+            pinned: vec![0],
+            ..Boundary::default()
+        },
+        Settings::default(),
+        1.0,
+    )
+    .unwrap()
+}
+
+fn newton(c: &mut Criterion) {
+    let mut g = c.benchmark_group("newton");
+    g.sample_size(10);
+    for nt in [1000, 4000, 16000, 64000] {
+        let sim = simulation(nt);
+        let label = sim.stencils.len();
+        g.bench_function(format!("iteration/{label}"), |b| {
+            b.iter(|| black_box(sim.newton_direction().unwrap()))
+        });
+        g.bench_function(format!("assembly/{label}"), |b| {
+            b.iter(|| {
+                black_box(hylc::shell::assemble::assemble(
+                    &sim.model,
+                    &sim.stencils,
+                    &sim.pattern,
+                    &sim.x,
+                    true,
+                    false,
+                ))
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, triangles, newton);
+criterion_main!(benches);

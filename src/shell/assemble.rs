@@ -1,0 +1,293 @@
+//! Parallel assembly of the shell energy, gradient and Hessian into a fixed sparsity pattern
+//! (`05-macro.md`, "The cloth solver").
+//!
+//! The pattern is built once per mesh and set of constrained vertices: the Hessian of the free dofs, lower
+//! triangle, compressed sparse columns, with a 3×3 block for every pair of free vertices that share a stencil.
+//! Every stencil stores where each of its 3×3 blocks lands ([`Pattern`]), so assembly is a plain scatter. The
+//! stencils are split into one contiguous range per rayon thread; each thread accumulates into its own value and
+//! gradient arrays, which are then summed (deterministic for a given thread count).
+
+use super::element::ElementModel;
+use super::mesh::Stencil;
+use super::strain::NDOF;
+use rayon::prelude::*;
+
+const NONE: u32 = u32::MAX;
+
+/// The sparsity pattern of the free-dof Hessian (lower triangle, CSC) and each stencil's scatter map.
+#[derive(Clone, Debug)]
+pub struct Pattern {
+    /// number of mesh vertices
+    pub n: usize,
+    /// free index of each vertex (`None`: constrained)
+    pub free: Vec<Option<usize>>,
+    /// number of free vertices (the system has 3 × this many unknowns)
+    pub nfree: usize,
+    pub col_ptr: Vec<usize>,
+    pub row_idx: Vec<usize>,
+    /// value index of each free dof's diagonal entry
+    pub diag: Vec<usize>,
+    /// per stencil, per (local vertex a, local vertex b, column c): value index of the first row stored
+    offs: Vec<[u32; 108]>,
+}
+
+impl Pattern {
+    /// The pattern for `stencils` on `n` vertices with the vertices flagged in `constrained` eliminated.
+    pub fn new(stencils: &[Stencil], n: usize, constrained: &[bool]) -> Pattern {
+        let mut free = vec![None; n];
+        let mut nfree = 0;
+        for v in 0..n {
+            if !constrained[v] {
+                free[v] = Some(nfree);
+                nfree += 1;
+            }
+        }
+        // neighbours (free index ≥ own) of every free vertex, including itself
+        let mut nb: Vec<Vec<usize>> = (0..nfree).map(|k| vec![k]).collect();
+        for s in stencils {
+            let live = live_vertices(s);
+            for &a in &live {
+                for &b in &live {
+                    if let (Some(ka), Some(kb)) = (free[s.v[a]], free[s.v[b]]) {
+                        if ka > kb {
+                            nb[kb].push(ka);
+                        }
+                    }
+                }
+            }
+        }
+        for l in nb.iter_mut() {
+            l.sort_unstable();
+            l.dedup();
+        }
+        let mut col_ptr = Vec::with_capacity(3 * nfree + 1);
+        let mut row_idx = Vec::new();
+        let mut diag = Vec::with_capacity(3 * nfree);
+        col_ptr.push(0);
+        for (kb, l) in nb.iter().enumerate() {
+            for c in 0..3 {
+                diag.push(row_idx.len());
+                for &ka in l {
+                    let r0 = if ka == kb { c } else { 0 };
+                    for r in r0..3 {
+                        row_idx.push(3 * ka + r);
+                    }
+                }
+                col_ptr.push(row_idx.len());
+            }
+        }
+        let offs = stencils
+            .iter()
+            .map(|s| {
+                let mut o = [NONE; 108];
+                for a in 0..6 {
+                    for b in 0..6 {
+                        if (a >= 3 && !s.flaps[a - 3]) || (b >= 3 && !s.flaps[b - 3]) {
+                            continue;
+                        }
+                        let (Some(ka), Some(kb)) = (free[s.v[a]], free[s.v[b]]) else {
+                            continue;
+                        };
+                        if ka < kb {
+                            continue;
+                        }
+                        let pos = nb[kb]
+                            .binary_search(&ka)
+                            .expect("pattern holds every stencil pair");
+                        for c in 0..3 {
+                            let start = col_ptr[3 * kb + c];
+                            o[18 * a + 3 * b + c] = if ka == kb {
+                                start as u32
+                            } else {
+                                (start + (3 - c) + 3 * (pos - 1)) as u32
+                            };
+                        }
+                    }
+                }
+                o
+            })
+            .collect();
+        Pattern {
+            n,
+            free,
+            nfree,
+            col_ptr,
+            row_idx,
+            diag,
+            offs,
+        }
+    }
+
+    /// Number of stored (lower-triangle) entries.
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// Add a symmetric 3×3 block to the diagonal block of free vertex `k`.
+    pub fn add_diag_block(&self, values: &mut [f64], k: usize, m: &[[f64; 3]; 3]) {
+        for c in 0..3 {
+            let start = self.diag[3 * k + c];
+            for r in c..3 {
+                values[start + r - c] += m[r][c];
+            }
+        }
+    }
+}
+
+/// Local vertices of a stencil that carry dofs (the triangle and its existing flaps).
+fn live_vertices(s: &Stencil) -> Vec<usize> {
+    (0..6).filter(|&a| a < 3 || s.flaps[a - 3]).collect()
+}
+
+/// Gather a stencil's 18 coordinates from the flat position vector.
+#[inline]
+pub fn gather(s: &Stencil, x: &[f64]) -> [f64; NDOF] {
+    let mut q = [0.0; NDOF];
+    for a in 0..6 {
+        for k in 0..3 {
+            q[3 * a + k] = x[3 * s.v[a] + k];
+        }
+    }
+    q
+}
+
+/// Result of one assembly.
+#[derive(Clone, Debug)]
+pub struct Assembled {
+    pub energy: f64,
+    /// gradient over all 3n dofs (constrained ones included, for reaction forces)
+    pub grad: Vec<f64>,
+    /// Hessian values in the pattern's order, with the model's PSD option (empty when not requested)
+    pub values: Vec<f64>,
+    /// exact Hessian values (only when requested with `exact_too`)
+    pub values_exact: Vec<f64>,
+    /// componentwise min and max of z over the mesh
+    pub zmin: [f64; 6],
+    pub zmax: [f64; 6],
+}
+
+/// Elastic energy only; `None` if any triangle is degenerate.
+pub fn energy(model: &ElementModel, stencils: &[Stencil], x: &[f64]) -> Option<f64> {
+    stencils
+        .par_iter()
+        .with_min_len(256)
+        .map(|s| model.energy(&gather(s, x), &s.rest, s.flaps))
+        .try_reduce(|| 0.0, |a, b| Some(a + b))
+}
+
+/// Energy, gradient and (if `hessian`) the free-dof Hessian of the elastic energy with the model's PSD option,
+/// and with `exact_too` also the exact Hessian (same evaluation); `None` if any triangle is degenerate.
+pub fn assemble(
+    model: &ElementModel,
+    stencils: &[Stencil],
+    pattern: &Pattern,
+    x: &[f64],
+    hessian: bool,
+    exact_too: bool,
+) -> Option<Assembled> {
+    let exact_too = hessian && exact_too;
+    if stencils.is_empty() {
+        return Some(Assembled {
+            energy: 0.0,
+            grad: vec![0.0; x.len()],
+            values: vec![0.0; if hessian { pattern.nnz() } else { 0 }],
+            values_exact: vec![0.0; if exact_too { pattern.nnz() } else { 0 }],
+            zmin: [0.0; 6],
+            zmax: [0.0; 6],
+        });
+    }
+    let nthreads = rayon::current_num_threads().max(1);
+    let chunk = stencils.len().div_ceil(nthreads).max(1);
+    let nnz = if hessian { pattern.nnz() } else { 0 };
+    let parts: Vec<Option<Assembled>> = stencils
+        .par_chunks(chunk)
+        .enumerate()
+        .map(|(ci, ss)| {
+            let mut out = Assembled {
+                energy: 0.0,
+                grad: vec![0.0; x.len()],
+                values: vec![0.0; nnz],
+                values_exact: vec![0.0; if exact_too { nnz } else { 0 }],
+                zmin: [f64::INFINITY; 6],
+                zmax: [f64::NEG_INFINITY; 6],
+            };
+            let mut g = [0.0; NDOF];
+            let mut h = [[0.0; NDOF]; NDOF];
+            let mut hx = [[0.0; NDOF]; NDOF];
+            for (si, s) in ss.iter().enumerate() {
+                let q = gather(s, x);
+                let (e, z) = if exact_too {
+                    model.energy_gradient_hessians(&q, &s.rest, s.flaps, &mut g, &mut hx, &mut h)?
+                } else if hessian {
+                    model.energy_gradient_hessian(&q, &s.rest, s.flaps, &mut g, &mut h)?
+                } else {
+                    model.energy_gradient(&q, &s.rest, s.flaps, &mut g)?
+                };
+                out.energy += e;
+                for k in 0..6 {
+                    out.zmin[k] = out.zmin[k].min(z[k]);
+                    out.zmax[k] = out.zmax[k].max(z[k]);
+                }
+                for a in 0..6 {
+                    if a >= 3 && !s.flaps[a - 3] {
+                        continue;
+                    }
+                    for k in 0..3 {
+                        out.grad[3 * s.v[a] + k] += g[3 * a + k];
+                    }
+                }
+                if hessian {
+                    let offs = &pattern.offs[ci * chunk + si];
+                    for a in 0..6 {
+                        for b in 0..6 {
+                            let base = 18 * a + 3 * b;
+                            if offs[base] == NONE {
+                                continue;
+                            }
+                            let diag = pattern.free[s.v[a]] == pattern.free[s.v[b]];
+                            for c in 0..3 {
+                                let start = offs[base + c] as usize;
+                                let r0 = if diag { c } else { 0 };
+                                for r in r0..3 {
+                                    out.values[start + r - r0] += h[3 * a + r][3 * b + c];
+                                }
+                                if exact_too {
+                                    for r in r0..3 {
+                                        out.values_exact[start + r - r0] +=
+                                            hx[3 * a + r][3 * b + c];
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            Some(out)
+        })
+        .collect();
+    let mut parts: Vec<Assembled> = parts.into_iter().collect::<Option<Vec<_>>>()?;
+    let mut total = parts.swap_remove(0);
+    for p in &parts {
+        total.energy += p.energy;
+        total
+            .grad
+            .par_iter_mut()
+            .zip(p.grad.par_iter())
+            .for_each(|(a, b)| *a += b);
+        total
+            .values
+            .par_iter_mut()
+            .zip(p.values.par_iter())
+            .for_each(|(a, b)| *a += b);
+        total
+            .values_exact
+            .par_iter_mut()
+            .zip(p.values_exact.par_iter())
+            .for_each(|(a, b)| *a += b);
+        for k in 0..6 {
+            total.zmin[k] = total.zmin[k].min(p.zmin[k]);
+            total.zmax[k] = total.zmax[k].max(p.zmax[k]);
+        }
+    }
+    Some(total)
+}

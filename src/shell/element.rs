@@ -1,0 +1,372 @@
+//! Triangle energy E_Δ = A·k·ψ(S z(q)), its gradient and Hessian (`05-macro.md`, "Per triangle"), with the
+//! scene's modelling choices and the three Hessian options of the note.
+//!
+//! - k: stiffness multiplier; S = diag(1, 1, 1, β, β, β) with β the bending scale (multiplies II before ψ), as in
+//!   the original's config.
+//! - "Model only what a scene requires" ([`ElementModel::new`]): without bending, the hinges are not evaluated
+//!   at all (II ≡ 0); with only 1D terms (the original's `only1D`) or in-plane terms only, the material is reduced
+//!   to those terms once, so ψ evaluates only them.
+//! - ∇E = A k Jᵀ S ∇ψ, ∇²E = A k (Jᵀ S ∇²ψ S J + Σ_k (S∇ψ)_k ∇²z_k).
+//!
+//! PSD options ([`Psd`]): (a) eigen-projection of the 18×18 local Hessian, eigenvalues clamped at 1e-8 like the
+//! original; (b) projection of the 6×6 ∇²ψ only, keeping of the Σ ∂ψ/∂z_k ∇²z_k term only the stretch parts whose
+//! weight is ≥ 0 (∇²‖F₀‖ and ∇²‖F₁‖ are PSD because ‖F_c‖ is convex and F is linear in q: a cheap sufficient test
+//! for "only where it is PSD"); (c) the exact Hessian, the solver adding a global diagonal shift when the
+//! factorisation fails.
+
+use super::strain::{strain, RestTriangle, StrainChain, NDOF};
+use crate::material::Material;
+use nalgebra::{SMatrix, SymmetricEigen};
+
+/// How the local Hessian is made positive semi-definite (`05-macro.md`, options (a)–(c)).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Psd {
+    /// (a) eigen-projection of the 18×18 local Hessian
+    Full,
+    /// (b) projection of ∇²ψ (6×6) plus the PSD stretch parts of Σ ∂ψ/∂z_k ∇²z_k
+    Psi,
+    /// (c) exact Hessian; global diagonal shift on factorisation failure
+    None,
+}
+
+/// Eigenvalue floor of option (a), as in the original.
+pub const EIGEN_FLOOR: f64 = 1e-8;
+
+/// Which parts of ψ a scene needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModelFlags {
+    /// evaluate the bending strains (hinges); false: II ≡ 0
+    pub bending: bool,
+    /// keep only the 1D terms of ψ (the original's `only1D`)
+    pub only_1d: bool,
+    /// keep only the in-plane terms (s_x, s_a, s_y and their 2D couplings); implies no bending
+    pub in_plane_only: bool,
+    /// stiffness multiplier k
+    pub stiffness: f64,
+    /// bending scale β (multiplies II before ψ)
+    pub bending_scale: f64,
+}
+
+impl Default for ModelFlags {
+    fn default() -> Self {
+        ModelFlags {
+            bending: true,
+            only_1d: false,
+            in_plane_only: false,
+            stiffness: 1.0,
+            bending_scale: 1.0,
+        }
+    }
+}
+
+/// The per-triangle model: reduced material, multipliers, PSD option.
+#[derive(Clone, Debug)]
+pub struct ElementModel {
+    pub material: Material,
+    pub bending: bool,
+    pub stiffness: f64,
+    pub bending_scale: f64,
+    pub psd: Psd,
+}
+
+impl ElementModel {
+    /// Reduce `material` to what `flags` require (see the module documentation).
+    pub fn new(material: &Material, flags: &ModelFlags, psd: Psd) -> Self {
+        let mut m = material.clone();
+        let bending = flags.bending && !flags.in_plane_only;
+        if flags.only_1d {
+            m.terms2d.clear();
+        }
+        if !bending {
+            m.terms1d.retain(|t| t.k <= 2);
+            m.terms2d.retain(|t| t.k1 <= 2);
+        }
+        ElementModel {
+            material: m,
+            bending,
+            stiffness: flags.stiffness,
+            bending_scale: flags.bending_scale,
+            psd,
+        }
+    }
+
+    #[inline]
+    fn flaps(&self, flaps: [bool; 3]) -> [bool; 3] {
+        if self.bending {
+            flaps
+        } else {
+            [false; 3]
+        }
+    }
+
+    /// The strain ψ receives: S z.
+    #[inline]
+    fn scaled(&self, z: &[f64; 6]) -> [f64; 6] {
+        let b = self.bending_scale;
+        [z[0], z[1], z[2], b * z[3], b * z[4], b * z[5]]
+    }
+
+    /// The strain z the model uses (bending zero when off), `None` on a degenerate configuration.
+    pub fn strain(
+        &self,
+        q: &[f64; NDOF],
+        rest: &RestTriangle,
+        flaps: [bool; 3],
+    ) -> Option<[f64; 6]> {
+        strain(q, rest, self.flaps(flaps))
+    }
+
+    /// E_Δ only; `None` on a degenerate configuration.
+    pub fn energy(&self, q: &[f64; NDOF], rest: &RestTriangle, flaps: [bool; 3]) -> Option<f64> {
+        let z = strain(q, rest, self.flaps(flaps))?;
+        let e = rest.area * self.stiffness * self.material.value(&self.scaled(&z));
+        e.is_finite().then_some(e)
+    }
+
+    /// E_Δ and ∇E_Δ (written to `grad`).
+    pub fn energy_gradient(
+        &self,
+        q: &[f64; NDOF],
+        rest: &RestTriangle,
+        flaps: [bool; 3],
+        grad: &mut [f64; NDOF],
+    ) -> Option<(f64, [f64; 6])> {
+        let ch = StrainChain::new(q, rest, self.flaps(flaps))?;
+        let p = self.material.eval(&self.scaled(&ch.z));
+        let (_, w) = self.weights(rest, &p.grad);
+        for j in 0..NDOF {
+            grad[j] = (0..6).map(|k| w[k] * ch.jac[k][j]).sum();
+        }
+        let e = rest.area * self.stiffness * p.value;
+        e.is_finite().then_some((e, ch.z))
+    }
+
+    /// c = A k and the weights A k S ∇ψ.
+    #[inline]
+    fn weights(&self, rest: &RestTriangle, g: &[f64; 6]) -> (f64, [f64; 6]) {
+        let c = rest.area * self.stiffness;
+        let b = self.bending_scale;
+        (
+            c,
+            [
+                c * g[0],
+                c * g[1],
+                c * g[2],
+                c * b * g[3],
+                c * b * g[4],
+                c * b * g[5],
+            ],
+        )
+    }
+
+    /// E_Δ, ∇E_Δ and the (optionally projected) ∇²E_Δ; also returns z. `None` on a degenerate configuration.
+    pub fn energy_gradient_hessian(
+        &self,
+        q: &[f64; NDOF],
+        rest: &RestTriangle,
+        flaps: [bool; 3],
+        grad: &mut [f64; NDOF],
+        hess: &mut [[f64; NDOF]; NDOF],
+    ) -> Option<(f64, [f64; 6])> {
+        let ch = StrainChain::new(q, rest, self.flaps(flaps))?;
+        let p = self.material.eval(&self.scaled(&ch.z));
+        let (c, w) = self.weights(rest, &p.grad);
+        let jac = &ch.jac;
+        for j in 0..NDOF {
+            grad[j] = (0..6).map(|k| w[k] * jac[k][j]).sum();
+        }
+        self.hessian_into(&ch, &p, c, &w, self.psd, hess);
+        let e = c * p.value;
+        e.is_finite().then_some((e, ch.z))
+    }
+
+    /// E_Δ, ∇E_Δ, the exact ∇²E_Δ (`exact`) and the Hessian of the model's PSD option (`projected`; equal to
+    /// `exact` for [`Psd::None`]) from one evaluation of the strain chain and ψ.
+    pub fn energy_gradient_hessians(
+        &self,
+        q: &[f64; NDOF],
+        rest: &RestTriangle,
+        flaps: [bool; 3],
+        grad: &mut [f64; NDOF],
+        exact: &mut [[f64; NDOF]; NDOF],
+        projected: &mut [[f64; NDOF]; NDOF],
+    ) -> Option<(f64, [f64; 6])> {
+        let ch = StrainChain::new(q, rest, self.flaps(flaps))?;
+        let p = self.material.eval(&self.scaled(&ch.z));
+        let (c, w) = self.weights(rest, &p.grad);
+        for j in 0..NDOF {
+            grad[j] = (0..6).map(|k| w[k] * ch.jac[k][j]).sum();
+        }
+        self.hessian_into(&ch, &p, c, &w, Psd::None, exact);
+        match self.psd {
+            Psd::None => *projected = *exact,
+            Psd::Full => {
+                *projected = *exact;
+                project18(projected);
+            }
+            Psd::Psi => self.hessian_into(&ch, &p, c, &w, Psd::Psi, projected),
+        }
+        let e = c * p.value;
+        e.is_finite().then_some((e, ch.z))
+    }
+
+    /// The local Hessian for PSD option `psd` from the chain, ψ's derivatives, c = A k and the weights w.
+    fn hessian_into(
+        &self,
+        ch: &StrainChain,
+        p: &crate::material::PsiVgh,
+        c: f64,
+        w: &[f64; 6],
+        psd: Psd,
+        hess: &mut [[f64; NDOF]; NDOF],
+    ) {
+        let jac = &ch.jac;
+        // H6 = c S ∇²ψ S (projected for option (b))
+        let s = [
+            1.0,
+            1.0,
+            1.0,
+            self.bending_scale,
+            self.bending_scale,
+            self.bending_scale,
+        ];
+        let mut h6 = [[0.0; 6]; 6];
+        for a in 0..6 {
+            for b in 0..6 {
+                h6[a][b] = c * s[a] * s[b] * p.hess[a][b];
+            }
+        }
+        if psd == Psd::Psi {
+            project6(&mut h6);
+        }
+        // T = H6 J (6×18), then Jᵀ T; columns of J that are zero (missing flaps) are skipped
+        let mut live = [true; NDOF];
+        for j in 0..NDOF {
+            live[j] = (0..6).any(|k| jac[k][j] != 0.0);
+        }
+        let mut t = [[0.0; NDOF]; 6];
+        for a in 0..6 {
+            for j in 0..NDOF {
+                if live[j] {
+                    t[a][j] = (0..6).map(|b| h6[a][b] * jac[b][j]).sum();
+                }
+            }
+        }
+        for i in 0..NDOF {
+            for j in 0..NDOF {
+                hess[i][j] = if live[i] && live[j] {
+                    (0..6).map(|a| jac[a][i] * t[a][j]).sum()
+                } else {
+                    0.0
+                };
+            }
+        }
+        match psd {
+            Psd::Psi => {
+                let w2 = [w[0].max(0.0), 0.0, w[2].max(0.0), 0.0, 0.0, 0.0];
+                ch.add_weighted_hessian(&w2, hess);
+            }
+            _ => ch.add_weighted_hessian(w, hess),
+        }
+        if psd == Psd::Full {
+            project18(hess);
+        }
+    }
+}
+
+/// Clamp the eigenvalues of a symmetric 6×6 matrix at 0.
+fn project6(h: &mut [[f64; 6]; 6]) {
+    let m = SMatrix::<f64, 6, 6>::from_fn(|i, j| 0.5 * (h[i][j] + h[j][i]));
+    let eig = SymmetricEigen::new(m);
+    if eig.eigenvalues.iter().all(|&l| l >= 0.0) {
+        return;
+    }
+    let l = eig.eigenvalues.map(|l| l.max(0.0));
+    let r =
+        eig.eigenvectors * SMatrix::<f64, 6, 6>::from_diagonal(&l) * eig.eigenvectors.transpose();
+    for i in 0..6 {
+        for j in 0..6 {
+            h[i][j] = r[(i, j)];
+        }
+    }
+}
+
+/// Clamp the eigenvalues of the symmetric 18×18 local Hessian at [`EIGEN_FLOOR`] (option (a)). A Cholesky
+/// attempt on H + floor·I first: when it succeeds every eigenvalue is above −floor (an element Hessian always
+/// has the six-dimensional null space of rigid motions, so "above +floor" never holds), and H is returned
+/// unchanged (most stretched triangles: at most a 2e-8 difference from the original's clamp, in null-space
+/// directions); else H + Σ_{λ_k < floor} (floor − λ_k) v_k v_kᵀ from the eigen-decomposition.
+pub fn project18(h: &mut [[f64; NDOF]; NDOF]) {
+    let mut m = SMatrix::<f64, NDOF, NDOF>::from_fn(|i, j| 0.5 * (h[i][j] + h[j][i]));
+    // columns and rows of unused (missing-flap) dofs are zero: keep them out of the test
+    let live: Vec<usize> = (0..NDOF)
+        .filter(|&i| (0..NDOF).any(|j| m[(i, j)] != 0.0))
+        .collect();
+    if cholesky_above_minus_floor(&m, &live) {
+        return;
+    }
+    for i in 0..NDOF {
+        for j in 0..NDOF {
+            h[i][j] = m[(i, j)];
+        }
+    }
+    let eig = SymmetricEigen::new(std::mem::take(&mut m));
+    for k in 0..NDOF {
+        let l = eig.eigenvalues[k];
+        if l < EIGEN_FLOOR {
+            let d = EIGEN_FLOOR - l;
+            let v = eig.eigenvectors.column(k);
+            for i in 0..NDOF {
+                let vi = d * v[i];
+                for j in 0..NDOF {
+                    h[i][j] += vi * v[j];
+                }
+            }
+        }
+    }
+}
+
+/// True when the principal submatrix on `live` plus floor·I has a Cholesky factorisation (all eigenvalues of
+/// that block above −floor).
+fn cholesky_above_minus_floor(m: &SMatrix<f64, NDOF, NDOF>, live: &[usize]) -> bool {
+    let n = live.len();
+    let mut l = [[0.0; NDOF]; NDOF];
+    for a in 0..n {
+        for b in 0..=a {
+            let mut s = m[(live[a], live[b])] + if a == b { EIGEN_FLOOR } else { 0.0 };
+            for k in 0..b {
+                s -= l[a][k] * l[b][k];
+            }
+            if a == b {
+                if s.is_nan() || s <= 0.0 {
+                    return false;
+                }
+                l[a][a] = s.sqrt();
+            } else {
+                l[a][b] = s / l[b][b];
+            }
+        }
+    }
+    true
+}
+
+/// Generic reference twin of E_Δ: A k ψ(S z(q)) from the reference strain chain and the reference material.
+pub fn energy_reference<D: crate::diff::Real>(
+    model: &ElementModel,
+    q: &[D],
+    rest: &RestTriangle,
+    flaps: [bool; 3],
+) -> D {
+    let z = super::strain::strain_reference(q, rest, model.flaps(flaps));
+    let b = model.bending_scale;
+    let zs = [
+        z[0].clone(),
+        z[1].clone(),
+        z[2].clone(),
+        z[3].clone() * b,
+        z[4].clone() * b,
+        z[5].clone() * b,
+    ];
+    model.material.reference(&zs) * (rest.area * model.stiffness)
+}
