@@ -67,3 +67,48 @@ fn a_solve_stopped_early_is_reported_and_has_no_psi() {
     assert!(v["psi"].is_null());
     assert_eq!(v["steps"], 1);
 }
+
+#[test]
+fn a_time_limit_is_reported_as_such() {
+    let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
+        .args([
+            "solve",
+            "plain",
+            "--z",
+            "0.3,0.4,0.1",
+            "--time-limit",
+            "0",
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(3), "{out:?}");
+    let v: serde_json::Value =
+        serde_json::from_str(String::from_utf8(out.stdout).unwrap().trim()).unwrap();
+    assert_eq!(v["status"], "TimeLimit");
+    assert!(v["psi"].is_null());
+}
+
+#[test]
+fn reference_writes_a_pattern_that_loads_and_is_an_equilibrium() {
+    let dir = std::env::temp_dir().join("hylc_micro_cli_ref");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("plain_ref.pyp");
+    let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
+        .args(["reference", "plain", "--out", file.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let (p, warnings) = hylc::pattern::Pattern::load_pyp(&file).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    // solving the written reference at zero strain stays put (0–1 Newton steps)
+    let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
+        .args(["solve", file.to_str().unwrap(), "--json"])
+        .output()
+        .unwrap();
+    let v: serde_json::Value =
+        serde_json::from_str(String::from_utf8(out.stdout).unwrap().trim()).unwrap();
+    assert_eq!(v["status"], "Converged");
+    assert!(v["steps"].as_u64().unwrap() <= 1, "{v}");
+    assert_eq!(p.len(), 40);
+}
