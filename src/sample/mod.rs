@@ -3,5 +3,7 @@
 //! shards and merging.
 
 pub mod plan;
+pub mod run;
 
 pub use plan::{sample_range, Chain, Plan, PlanError, Sample, Step};
+pub use run::{merge, parse_shard, read_samples, run_plan, Record, RunOptions, RunSummary};
