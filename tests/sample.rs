@@ -2,6 +2,9 @@
 //! sample file was cut mid-line, or after the CLI was killed with SIGKILL, writes the same records as an
 //! uninterrupted run (Ψ̄ and stresses bitwise); shards merged equal the unsharded run.
 
+mod common;
+
+use common::cli_error;
 use hylc::micro::{MicroProblem, SolverOptions};
 use hylc::pattern::generate::default_pattern;
 use hylc::rod::YarnMaterial;
@@ -250,5 +253,59 @@ fn cli_killed_with_sigkill_resumes_to_the_same_records() {
         RunOptions::default(),
     );
     assert_same(&full, &resumed);
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn cli_plan_files_and_bad_input() {
+    let d = dir("cli");
+    let exe = env!("CARGO_BIN_EXE_hylc");
+    // `hylc plan --write` writes plans that load back to the same plan (same hash, so the same ids)
+    for (flag, plan) in [
+        (None, Plan::default()),
+        (Some("--reduced"), Plan::reduced()),
+    ] {
+        let f = d.join("plan.json");
+        let mut args = vec![
+            "plan".to_string(),
+            "--write".into(),
+            f.display().to_string(),
+        ];
+        args.extend(flag.map(String::from));
+        let out = Command::new(exe).args(&args).output().expect("run");
+        assert!(out.status.success());
+        let loaded = Plan::load(&f).expect("load");
+        assert_eq!(loaded, plan);
+        assert_eq!(loaded.hash(), plan.hash());
+    }
+    // a bad plan file: one line naming the file and the field
+    let bad = d.join("bad.json");
+    std::fs::write(&bad, r#"{"ranges":{},"count_1d":3}"#).unwrap();
+    let out_file = d.join("x.jsonl");
+    let (b, o) = (bad.display().to_string(), out_file.display().to_string());
+    let err = cli_error(&["sample", "plain", "--plan", &b, "--out", &o]);
+    assert!(
+        err.contains("bad.json") && err.contains("ranges.s_x"),
+        "{err}"
+    );
+    let err = cli_error(&[
+        "sample", "plain", "--plan", "reduced", "--out", &o, "--shard", "2/2",
+    ]);
+    assert!(err.contains("--shard"), "{err}");
+    let err = cli_error(&[
+        "sample",
+        "no-such-pattern",
+        "--plan",
+        "reduced",
+        "--out",
+        &o,
+    ]);
+    assert!(err.contains("no-such-pattern"), "{err}");
+    // a sample file that is not a sample file is not appended to
+    std::fs::write(&out_file, "hello\n").unwrap();
+    let err = cli_error(&["sample", "plain", "--plan", "reduced", "--out", &o]);
+    assert!(err.contains("x.jsonl:1"), "{err}");
+    let err = cli_error(&["merge", &d.join("m.jsonl").display().to_string()]);
+    assert!(err.contains("no input"), "{err}");
     std::fs::remove_dir_all(&d).ok();
 }
