@@ -10,7 +10,8 @@
 //!   full line and then synced to disk, so an interrupted run loses at most the sample in flight.
 //! - Resume: ids already in the file are skipped (a truncated last line is cut off first). Skipped samples that a
 //!   remaining sample continues from are re-solved (not re-written) to recover their states, so a resumed run
-//!   writes bitwise the same records as an uninterrupted one.
+//!   writes bitwise the same records as an uninterrupted one (unless a solve hits a wall-time limit, whose
+//!   outcome depends on the machine's load).
 //! - Shards: shard k of n runs the chains with index ≡ k (mod n); [`merge`] concatenates shard files and removes
 //!   duplicate ids.
 
