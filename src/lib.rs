@@ -10,6 +10,7 @@ pub mod material;
 pub mod micro;
 pub mod pattern;
 pub mod rod;
+pub mod sample;
 pub mod shell;
 pub mod tile;
 

@@ -6,6 +6,8 @@ mod calibrate;
 mod micro;
 #[path = "hylc/micro_grid.rs"]
 mod micro_grid;
+#[path = "hylc/sample.rs"]
+mod sample;
 #[path = "hylc/simulate.rs"]
 mod simulate;
 
@@ -141,6 +143,52 @@ enum Command {
         /// print one line per Newton step to stderr
         #[arg(long)]
         trace: bool,
+    },
+    /// Run a sampling plan on a pattern (warm-started chains in parallel), appending to a JSON-lines sample
+    /// file; finished samples are skipped, so an interrupted run resumes where it stopped.
+    Sample {
+        /// `.pyp` file, or a generated kind (plain, twill, satin, basket, stockinette)
+        pattern: String,
+        /// plan JSON file, or `default` / `reduced`
+        #[arg(long, default_value = "default")]
+        plan: String,
+        /// sample file (JSON lines; appended to)
+        #[arg(long)]
+        out: PathBuf,
+        /// start every sample from the reference state
+        #[arg(long)]
+        cold: bool,
+        /// run shard k of n (chains with index ≡ k mod n)
+        #[arg(long, value_name = "K/N")]
+        shard: Option<String>,
+        /// stop after writing this many samples
+        #[arg(long)]
+        limit: Option<usize>,
+        /// force tolerance relative to the stretching stiffness
+        #[arg(long, default_value_t = 1e-8)]
+        tolerance: f64,
+        /// Newton step limit
+        #[arg(long, default_value_t = 2000)]
+        max_steps: usize,
+        /// wall-time limit per solve in seconds
+        #[arg(long)]
+        time_limit: Option<f64>,
+    },
+    /// Merge sample files (e.g. shards) into one, dropping duplicate ids.
+    Merge {
+        /// merged sample file
+        out: PathBuf,
+        /// input sample files
+        inputs: Vec<PathBuf>,
+    },
+    /// Write the default sampling plan (or the reduced one) as JSON.
+    Plan {
+        /// plan file to write
+        #[arg(long)]
+        write: PathBuf,
+        /// the reduced plan (30 per 1D range, 10×10 grids)
+        #[arg(long)]
+        reduced: bool,
     },
     /// Compute the reference state of a pattern (Algorithm C1: stress-free state, tension, zero-stress periods,
     /// centring) and write it as `.pyp`.
@@ -290,6 +338,46 @@ fn main() -> ExitCode {
             obj.as_deref(),
             out.as_deref(),
         ),
+        Command::Sample {
+            pattern,
+            plan,
+            out,
+            cold,
+            shard,
+            limit,
+            tolerance,
+            max_steps,
+            time_limit,
+        } => {
+            let options = hylc::micro::SolverOptions {
+                tolerance,
+                max_steps,
+                time_limit,
+                ..Default::default()
+            };
+            sample::sample(
+                &pattern,
+                &plan,
+                &out,
+                cold,
+                shard.as_deref(),
+                limit,
+                options,
+            )
+            .map(|ok| {
+                if ok {
+                    ExitCode::SUCCESS
+                } else {
+                    ExitCode::from(3)
+                }
+            })
+        }
+        Command::Merge { out, inputs } => {
+            sample::merge_cmd(&out, &inputs).map(|_| ExitCode::SUCCESS)
+        }
+        Command::Plan { write, reduced } => {
+            sample::plan_cmd(&write, reduced).map(|_| ExitCode::SUCCESS)
+        }
         Command::Solve {
             pattern,
             z,

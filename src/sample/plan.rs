@@ -1,0 +1,674 @@
+//! Sampling plans (`../shared/design/04-sampling-fitting.md`, section "Sampling plan (C4)").
+//!
+//! A [`Plan`] lists per-strain ranges, the sample counts of the 1D ranges and of the 2D grids, and the strain
+//! pairs of the grids. Its samples are enumerated in a fixed order (the five 1D ranges, then the grids row-major),
+//! each with a stable id: the FNV-1a 64 hash of the plan's canonical JSON and the sample's index. For
+//! warm-started continuation the samples are grouped into [`Chain`]s: each 1D range is two rays solved outward
+//! from the sample nearest z = 0; each 2D grid first solves its axis (the column nearest zero in the second
+//! strain) as two rays from the point nearest the origin, then continues every row as two rays from that axis.
+
+use crate::micro::strain::STRAIN_NAMES;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::path::Path;
+
+/// SAMPLERANGE(z, z_min, z_max, N) of the design: for the stretches s_x, s_y (`k` = 0, 2)
+/// Z = linspace((z_min+1)^(1/10), (z_max+1)^(1/10), N)^10 − 1 (denser towards compression); for s_a, Π₀₀, Π₁₁
+/// (`k` = 1, 3, 4) Z = linspace(−√|z_min|, √|z_max|, N), then Z = sgn(Z) Z² (denser near 0).
+/// `n` = 1 gives the lower end (as `linspace` does).
+pub fn sample_range(k: usize, z_min: f64, z_max: f64, n: usize) -> Vec<f64> {
+    let linspace = |a: f64, b: f64| -> Vec<f64> {
+        match n {
+            0 => vec![],
+            1 => vec![a],
+            _ => (0..n)
+                .map(|i| {
+                    if i == n - 1 {
+                        b
+                    } else {
+                        a + (b - a) * i as f64 / (n - 1) as f64
+                    }
+                })
+                .collect(),
+        }
+    };
+    if k == 0 || k == 2 {
+        linspace((z_min + 1.0).powf(0.1), (z_max + 1.0).powf(0.1))
+            .into_iter()
+            .map(|v| v.powi(10) - 1.0)
+            .collect()
+    } else {
+        linspace(-z_min.abs().sqrt(), z_max.abs().sqrt())
+            .into_iter()
+            .map(|v| v.signum() * v * v)
+            .collect()
+    }
+}
+
+/// Per-strain ranges [min, max] (design defaults: s_x, s_y ∈ [−0.6, 0.96], s_a ∈ [−0.7, 0.7], Π ∈ [−160, 160]
+/// m⁻¹).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Ranges {
+    pub s_x: [f64; 2],
+    pub s_a: [f64; 2],
+    pub s_y: [f64; 2],
+    #[serde(rename = "II00")]
+    pub ii00: [f64; 2],
+    #[serde(rename = "II11")]
+    pub ii11: [f64; 2],
+}
+
+impl Ranges {
+    /// The range of strain `k` (0..5: s_x, s_a, s_y, Π₀₀, Π₁₁).
+    pub fn get(&self, k: usize) -> [f64; 2] {
+        [self.s_x, self.s_a, self.s_y, self.ii00, self.ii11][k]
+    }
+}
+
+impl Default for Ranges {
+    fn default() -> Self {
+        Ranges {
+            s_x: [-0.6, 0.96],
+            s_a: [-0.7, 0.7],
+            s_y: [-0.6, 0.96],
+            ii00: [-160.0, 160.0],
+            ii11: [-160.0, 160.0],
+        }
+    }
+}
+
+/// A sampling plan (`04-sampling-fitting.md`, "Sampling plan (C4)"), stored as JSON.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Plan {
+    /// Per-strain ranges.
+    pub ranges: Ranges,
+    /// Samples of each 1D range (default 150).
+    pub count_1d: usize,
+    /// Samples per axis of each 2D grid (default 50, i.e. 50×50).
+    pub count_2d: usize,
+    /// The strain pairs of the 2D grids, by name (`s_x`, `s_a`, `s_y`, `II00`, `II11`).
+    pub pairs: Vec<[String; 2]>,
+}
+
+/// The design's nine pairs: {s_x,s_a,s_y}² unordered distinct, then {s_x,s_a,s_y}×{Π₀₀,Π₁₁}.
+pub fn default_pairs() -> Vec<[String; 2]> {
+    let p = |a: &str, b: &str| [a.to_string(), b.to_string()];
+    vec![
+        p("s_x", "s_a"),
+        p("s_x", "s_y"),
+        p("s_a", "s_y"),
+        p("s_x", "II00"),
+        p("s_x", "II11"),
+        p("s_a", "II00"),
+        p("s_a", "II11"),
+        p("s_y", "II00"),
+        p("s_y", "II11"),
+    ]
+}
+
+impl Default for Plan {
+    /// The design's default plan: 5 × 150 + 9 × 50² = 23 250 samples.
+    fn default() -> Self {
+        Plan {
+            ranges: Ranges::default(),
+            count_1d: 150,
+            count_2d: 50,
+            pairs: default_pairs(),
+        }
+    }
+}
+
+/// A bad plan: the file (if any), the field and what is wrong.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanError {
+    pub file: Option<String>,
+    pub field: String,
+    pub message: String,
+}
+
+impl fmt::Display for PlanError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some(file) = &self.file {
+            write!(f, "{file}: ")?;
+        }
+        write!(f, "plan field {}: {}", self.field, self.message)
+    }
+}
+
+impl std::error::Error for PlanError {}
+
+/// One sample of a plan.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sample {
+    /// Position in the plan's enumeration.
+    pub index: usize,
+    /// Stable id: `<plan hash, 16 hex digits>-<index>`.
+    pub id: String,
+    /// The strain z = (s_x, s_a, s_y, Π₀₀, Π₁₁).
+    pub z: [f64; 5],
+}
+
+/// One step of a continuation chain: solve sample `sample`, starting from the state of step `from` of the same
+/// chain (the reference state when `None`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Step {
+    pub sample: usize,
+    pub from: Option<usize>,
+}
+
+/// A continuation chain: steps in solve order; every step's `from` is an earlier step, so a chain is solved
+/// sequentially and its results depend only on the chain.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Chain {
+    pub steps: Vec<Step>,
+}
+
+/// FNV-1a 64 of bytes.
+pub fn fnv1a64(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
+/// The index of a strain name (`s_x` 0, `s_a` 1, `s_y` 2, `II00` 3, `II11` 4).
+pub fn strain_index(name: &str) -> Option<usize> {
+    STRAIN_NAMES.iter().position(|n| *n == name)
+}
+
+/// Indices of `values` ordered as two rays outward from the value nearest 0: the nearest index first, then
+/// upwards, then downwards. Returns (origin, up, down).
+fn rays(values: &[f64]) -> (usize, Vec<usize>, Vec<usize>) {
+    let mut origin = 0;
+    for (i, v) in values.iter().enumerate() {
+        if v.abs() < values[origin].abs() {
+            origin = i;
+        }
+    }
+    let up = (origin + 1..values.len()).collect();
+    let down = (0..origin).rev().collect();
+    (origin, up, down)
+}
+
+/// Append a ray (steps continuing from `start`) to `steps`, returning the step index of each element.
+fn push_ray(steps: &mut Vec<Step>, start: usize, samples: impl IntoIterator<Item = usize>) {
+    let mut from = start;
+    for s in samples {
+        steps.push(Step {
+            sample: s,
+            from: Some(from),
+        });
+        from = steps.len() - 1;
+    }
+}
+
+impl Plan {
+    /// A reduced plan for quick runs and tests: 30 samples per 1D range, 10×10 grids, default ranges and pairs.
+    pub fn reduced() -> Self {
+        Plan {
+            count_1d: 30,
+            count_2d: 10,
+            ..Plan::default()
+        }
+    }
+
+    /// Check ranges, counts and pairs.
+    pub fn validate(&self) -> Result<(), PlanError> {
+        let err = |field: String, message: String| PlanError {
+            file: None,
+            field,
+            message,
+        };
+        for (k, name) in STRAIN_NAMES.iter().enumerate() {
+            let [lo, hi] = self.ranges.get(k);
+            if !lo.is_finite() || !hi.is_finite() || lo > hi {
+                return Err(err(
+                    format!("ranges.{name}"),
+                    format!("[{lo}, {hi}] is not a finite range with min ≤ max"),
+                ));
+            }
+            if (k == 0 || k == 2) && lo <= -1.0 {
+                return Err(err(
+                    format!("ranges.{name}"),
+                    format!("the lower end {lo} must be above −1 (a stretch)"),
+                ));
+            }
+            if (k == 1 || k >= 3) && (lo > 0.0 || hi < 0.0) {
+                return Err(err(
+                    format!("ranges.{name}"),
+                    format!("[{lo}, {hi}] must contain 0 (SAMPLERANGE mirrors √|z| about 0)"),
+                ));
+            }
+        }
+        for (i, [a, b]) in self.pairs.iter().enumerate() {
+            let ka = strain_index(a);
+            let kb = strain_index(b);
+            match (ka, kb) {
+                (Some(ka), Some(kb)) if ka != kb => {
+                    if self.pairs[..i]
+                        .iter()
+                        .any(|[c, d]| (c == a && d == b) || (c == b && d == a))
+                    {
+                        return Err(err(
+                            format!("pairs[{i}]"),
+                            format!("[{a:?}, {b:?}] is listed twice"),
+                        ));
+                    }
+                    if ka >= 3 && kb >= 3 {
+                        return Err(err(
+                            format!("pairs[{i}]"),
+                            "two bending strains at once are not a supported strain direction"
+                                .into(),
+                        ));
+                    }
+                }
+                _ => {
+                    return Err(err(
+                        format!("pairs[{i}]"),
+                        format!(
+                            "[{a:?}, {b:?}] must name two different strains of {}",
+                            STRAIN_NAMES.join(", ")
+                        ),
+                    ))
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Parse and validate a plan from JSON text; `file` names the source in errors, and every error names the
+    /// field (`count_1d`, `ranges.s_x`, `pairs[2]`, …).
+    pub fn from_json(text: &str, file: Option<&str>) -> Result<Self, PlanError> {
+        let err = |field: &str, message: String| PlanError {
+            file: file.map(str::to_string),
+            field: field.to_string(),
+            message,
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| err("-", format!("not JSON: {e}")))?;
+        let obj = value
+            .as_object()
+            .ok_or_else(|| err("-", "a plan is a JSON object".into()))?;
+        const FIELDS: [&str; 4] = ["ranges", "count_1d", "count_2d", "pairs"];
+        for key in obj.keys() {
+            if !FIELDS.contains(&key.as_str()) {
+                return Err(err(
+                    key,
+                    format!("unknown field (expected one of {})", FIELDS.join(", ")),
+                ));
+            }
+        }
+        fn field<T: serde::de::DeserializeOwned>(
+            obj: &serde_json::Map<String, serde_json::Value>,
+            key: &str,
+        ) -> Result<T, String> {
+            let v = obj.get(key).ok_or_else(|| "missing".to_string())?;
+            serde_json::from_value(v.clone()).map_err(|e| e.to_string())
+        }
+        let ranges_obj = obj
+            .get("ranges")
+            .ok_or_else(|| err("ranges", "missing".into()))?
+            .as_object()
+            .ok_or_else(|| err("ranges", "expected an object of [min, max] pairs".into()))?;
+        for key in ranges_obj.keys() {
+            if !STRAIN_NAMES.contains(&key.as_str()) {
+                return Err(err(
+                    &format!("ranges.{key}"),
+                    format!("unknown strain (expected {})", STRAIN_NAMES.join(", ")),
+                ));
+            }
+        }
+        let mut r = [[0.0; 2]; 5];
+        for (k, name) in STRAIN_NAMES.iter().enumerate() {
+            r[k] = field(ranges_obj, name).map_err(|m| err(&format!("ranges.{name}"), m))?;
+        }
+        let plan = Plan {
+            ranges: Ranges {
+                s_x: r[0],
+                s_a: r[1],
+                s_y: r[2],
+                ii00: r[3],
+                ii11: r[4],
+            },
+            count_1d: field(obj, "count_1d").map_err(|m| err("count_1d", m))?,
+            count_2d: field(obj, "count_2d").map_err(|m| err("count_2d", m))?,
+            pairs: field(obj, "pairs").map_err(|m| err("pairs", m))?,
+        };
+        plan.validate().map_err(|mut e| {
+            e.file = file.map(str::to_string);
+            e
+        })?;
+        Ok(plan)
+    }
+
+    /// Load a plan file.
+    pub fn load(path: &Path) -> Result<Self, PlanError> {
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| PlanError {
+            file: Some(name.clone()),
+            field: "-".into(),
+            message: format!("cannot read: {e}"),
+        })?;
+        Plan::from_json(&text, Some(&name))
+    }
+
+    /// The canonical JSON (compact, fields in declaration order); the plan hash is taken over it.
+    pub fn canonical_json(&self) -> String {
+        serde_json::to_string(self).unwrap_or_default()
+    }
+
+    /// The plan hash: FNV-1a 64 of the canonical JSON.
+    pub fn hash(&self) -> u64 {
+        fnv1a64(self.canonical_json().as_bytes())
+    }
+
+    /// The values of strain `k` on its 1D range.
+    pub fn axis_1d(&self, k: usize) -> Vec<f64> {
+        let [lo, hi] = self.ranges.get(k);
+        sample_range(k, lo, hi, self.count_1d)
+    }
+
+    /// The values of strain `k` on a 2D grid axis.
+    pub fn axis_2d(&self, k: usize) -> Vec<f64> {
+        let [lo, hi] = self.ranges.get(k);
+        sample_range(k, lo, hi, self.count_2d)
+    }
+
+    /// Number of samples: 5 · count_1d + pairs · count_2d².
+    pub fn len(&self) -> usize {
+        5 * self.count_1d + self.pairs.len() * self.count_2d * self.count_2d
+    }
+
+    /// Whether the plan has no samples.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn pair_indices(&self) -> Vec<[usize; 2]> {
+        self.pairs
+            .iter()
+            .map(|[a, b]| [strain_index(a).unwrap_or(0), strain_index(b).unwrap_or(0)])
+            .collect()
+    }
+
+    /// All samples in plan order: the 1D ranges of s_x, s_a, s_y, Π₀₀, Π₁₁ (others 0), then each pair's grid,
+    /// row-major (index i of the first strain, j of the second: i·count_2d + j).
+    pub fn samples(&self) -> Vec<Sample> {
+        let hash = self.hash();
+        let mut zs: Vec<[f64; 5]> = Vec::with_capacity(self.len());
+        for k in 0..5 {
+            for v in self.axis_1d(k) {
+                let mut z = [0.0; 5];
+                z[k] = v;
+                zs.push(z);
+            }
+        }
+        for [a, b] in self.pair_indices() {
+            let va = self.axis_2d(a);
+            let vb = self.axis_2d(b);
+            for x in &va {
+                for y in &vb {
+                    let mut z = [0.0; 5];
+                    z[a] = *x;
+                    z[b] = *y;
+                    zs.push(z);
+                }
+            }
+        }
+        zs.into_iter()
+            .enumerate()
+            .map(|(index, z)| Sample {
+                index,
+                id: format!("{hash:016x}-{index}"),
+                z,
+            })
+            .collect()
+    }
+
+    /// The continuation chains (module docs): one per 1D range, then one per 2D grid. Every sample appears in
+    /// exactly one chain, once.
+    pub fn chains(&self) -> Vec<Chain> {
+        let mut chains = Vec::new();
+        for k in 0..5 {
+            let base = k * self.count_1d;
+            let values = self.axis_1d(k);
+            if values.is_empty() {
+                continue;
+            }
+            let (origin, up, down) = rays(&values);
+            let mut steps = vec![Step {
+                sample: base + origin,
+                from: None,
+            }];
+            push_ray(&mut steps, 0, up.into_iter().map(|i| base + i));
+            push_ray(&mut steps, 0, down.into_iter().map(|i| base + i));
+            chains.push(Chain { steps });
+        }
+        let n = self.count_2d;
+        for (p, [a, b]) in self.pair_indices().into_iter().enumerate() {
+            if n == 0 {
+                continue;
+            }
+            let base = 5 * self.count_1d + p * n * n;
+            let (i0, iup, idown) = rays(&self.axis_2d(a));
+            let (j0, jup, jdown) = rays(&self.axis_2d(b));
+            let at = |i: usize, j: usize| base + i * n + j;
+            // the axis: column j0, two rays from (i0, j0)
+            let mut steps = vec![Step {
+                sample: at(i0, j0),
+                from: None,
+            }];
+            let mut axis_step = vec![0usize; n];
+            for ray in [&iup, &idown] {
+                let mut from = 0;
+                for &i in ray {
+                    steps.push(Step {
+                        sample: at(i, j0),
+                        from: Some(from),
+                    });
+                    from = steps.len() - 1;
+                    axis_step[i] = from;
+                }
+            }
+            // the rows, in plan order, each as two rays from its axis point
+            for i in 0..n {
+                push_ray(&mut steps, axis_step[i], jup.iter().map(|&j| at(i, j)));
+                push_ray(&mut steps, axis_step[i], jdown.iter().map(|&j| at(i, j)));
+            }
+            chains.push(Chain { steps });
+        }
+        chains
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts() {
+        let p = Plan::default();
+        assert_eq!(p.len(), 5 * 150 + 9 * 2500);
+        assert_eq!(p.len(), 23_250);
+        assert_eq!(p.samples().len(), 23_250);
+        assert_eq!(Plan::reduced().samples().len(), 5 * 30 + 9 * 100);
+        assert_eq!(p.pairs.len(), 9);
+    }
+
+    #[test]
+    fn sample_range_endpoints_and_densification() {
+        let s = sample_range(0, -0.6, 0.96, 150);
+        assert_eq!(s.len(), 150);
+        assert!((s[0] + 0.6).abs() < 1e-12 && (s[149] - 0.96).abs() < 1e-12);
+        // denser towards compression: steps grow
+        let d: Vec<f64> = s.windows(2).map(|w| w[1] - w[0]).collect();
+        assert!(d.iter().all(|v| *v > 0.0));
+        assert!(d.windows(2).all(|w| w[1] > w[0]));
+        let a = sample_range(1, -0.7, 0.7, 51);
+        assert!((a[0] + 0.7).abs() < 1e-12 && (a[50] - 0.7).abs() < 1e-12);
+        assert_eq!(a[25], 0.0);
+        // denser near 0: steps shrink towards the middle
+        let d: Vec<f64> = a.windows(2).map(|w| w[1] - w[0]).collect();
+        assert!(d[0] > d[20] && d[49] > d[30]);
+        let b = sample_range(3, -160.0, 160.0, 50);
+        assert!((b[0] + 160.0).abs() < 1e-9 && (b[49] - 160.0).abs() < 1e-9);
+        assert!(b.windows(2).all(|w| w[1] > w[0]));
+        // exact formula at one interior point
+        let lo = 0.4f64.powf(0.1);
+        let hi = 1.96f64.powf(0.1);
+        let v = lo + (hi - lo) * 7.0 / 149.0;
+        assert_eq!(s[7], v.powi(10) - 1.0);
+    }
+
+    #[test]
+    fn ids_are_stable() {
+        // the hash of the default plan is fixed across runs and builds (canonical JSON, FNV-1a 64)
+        let p = Plan::default();
+        assert_eq!(p.hash(), fnv1a64(p.canonical_json().as_bytes()));
+        assert_eq!(fnv1a64(b"a"), 0xaf63dc4c8601ec8c);
+        let s = p.samples();
+        assert_eq!(s[17].id, format!("{:016x}-17", p.hash()));
+        assert_eq!(Plan::default().samples()[17].id, s[17].id);
+        assert_ne!(Plan::reduced().hash(), p.hash());
+        assert_eq!(
+            p.hash(),
+            PINNED_DEFAULT_HASH,
+            "the default plan's hash changed"
+        );
+    }
+
+    const PINNED_DEFAULT_HASH: u64 = 3_641_870_492_531_437_183;
+
+    #[test]
+    fn json_round_trip() {
+        for p in [Plan::default(), Plan::reduced()] {
+            let text = serde_json::to_string_pretty(&p).unwrap();
+            let q = Plan::from_json(&text, Some("x.json")).unwrap();
+            assert_eq!(p, q);
+            assert_eq!(p.hash(), q.hash());
+        }
+    }
+
+    #[test]
+    fn bad_json_errors_name_file_and_field() {
+        let good = serde_json::to_value(Plan::reduced()).unwrap();
+        let cases: Vec<(serde_json::Value, &str)> = vec![
+            (
+                {
+                    let mut v = good.clone();
+                    v["count_1d"] = "ten".into();
+                    v
+                },
+                "count_1d",
+            ),
+            (
+                {
+                    let mut v = good.clone();
+                    v["extra"] = 1.into();
+                    v
+                },
+                "extra",
+            ),
+            (
+                {
+                    let mut v = good.clone();
+                    v.as_object_mut().unwrap().remove("count_2d");
+                    v
+                },
+                "count_2d",
+            ),
+            (
+                {
+                    let mut v = good.clone();
+                    v["ranges"]["s_a"] = serde_json::json!([0.5, 0.7]);
+                    v
+                },
+                "ranges.s_a",
+            ),
+            (
+                {
+                    let mut v = good.clone();
+                    v["ranges"]["s_x"] = serde_json::json!([-1.5, 0.7]);
+                    v
+                },
+                "ranges.s_x",
+            ),
+            (
+                {
+                    let mut v = good.clone();
+                    v["ranges"]["s_q"] = serde_json::json!([0, 1]);
+                    v
+                },
+                "ranges.s_q",
+            ),
+            (
+                {
+                    let mut v = good.clone();
+                    v["pairs"][1] = serde_json::json!(["s_x", "s_z"]);
+                    v
+                },
+                "pairs[1]",
+            ),
+            (
+                {
+                    let mut v = good.clone();
+                    v["pairs"][1] = serde_json::json!(["s_a", "s_x"]);
+                    v
+                },
+                "pairs[1]",
+            ),
+            (
+                {
+                    let mut v = good.clone();
+                    v["pairs"][1] = serde_json::json!(["II00", "II11"]);
+                    v
+                },
+                "pairs[1]",
+            ),
+        ];
+        for (v, field) in cases {
+            let e = Plan::from_json(&v.to_string(), Some("plan.json")).unwrap_err();
+            assert_eq!(e.field, field, "{e}");
+            let msg = e.to_string();
+            assert!(msg.contains("plan.json") && msg.contains(field), "{msg}");
+        }
+        let e = Plan::from_json("{", Some("p.json")).unwrap_err();
+        assert!(e.to_string().starts_with("p.json: "));
+    }
+
+    #[test]
+    fn chains_cover_every_sample_once_and_start_near_zero() {
+        let p = Plan {
+            count_1d: 7,
+            count_2d: 5,
+            ..Plan::reduced()
+        };
+        let samples = p.samples();
+        let chains = p.chains();
+        assert_eq!(chains.len(), 5 + 9);
+        let mut seen = vec![0; p.len()];
+        for c in &chains {
+            assert_eq!(c.steps[0].from, None);
+            let z0 = samples[c.steps[0].sample].z;
+            for (i, s) in c.steps.iter().enumerate() {
+                seen[s.sample] += 1;
+                if i > 0 {
+                    let f = s.from.unwrap();
+                    assert!(f < i);
+                    // each step moves one grid index along one strain, away from the origin
+                    let a = samples[c.steps[f].sample].z;
+                    let b = samples[s.sample].z;
+                    let changed: Vec<usize> = (0..5).filter(|&k| a[k] != b[k]).collect();
+                    assert_eq!(changed.len(), 1);
+                    let k = changed[0];
+                    assert!((b[k] - z0[k]).abs() > (a[k] - z0[k]).abs());
+                }
+            }
+        }
+        assert!(seen.iter().all(|&n| n == 1));
+    }
+}

@@ -1,0 +1,430 @@
+//! Running a sampling plan on one pattern (`../shared/design/04-sampling-fitting.md`, section "Sampling plan
+//! (C4)", "Running a plan").
+//!
+//! - Chains ([`Plan::chains`]) run in parallel (rayon); each chain is sequential, so every sample's result depends
+//!   only on its chain and not on scheduling, shards or interruptions.
+//! - Warm start: each step starts from the equilibrium of the step it continues (the nearest converged one up the
+//!   chain), extrapolated with the secant predictor [`MicroProblem::predict`] when that step's own predecessor
+//!   converged too; `cold` starts every sample from the reference state.
+//! - The sample file is JSON lines, append-only: one [`Record`] per sample, written as one `write` call of the
+//!   full line and then synced to disk, so an interrupted run loses at most the sample in flight.
+//! - Resume: ids already in the file are skipped (a truncated last line is cut off first). Skipped samples that a
+//!   remaining sample continues from are re-solved (not re-written) to recover their states, so a resumed run
+//!   writes bitwise the same records as an uninterrupted one (unless a solve hits a wall-time limit, whose
+//!   outcome depends on the machine's load).
+//! - Shards: shard k of n runs the chains with index ≡ k (mod n); [`merge`] concatenates shard files and removes
+//!   duplicate ids.
+
+use super::plan::{fnv1a64, Plan};
+use crate::micro::envelope::strain_derivatives;
+use crate::micro::{MacroStrain, MicroProblem, MicroState, Status};
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::HashSet;
+use std::fs::{File, OpenOptions};
+use std::io::Write;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// One line of a sample file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Record {
+    /// Stable sample id (plan hash + index).
+    pub id: String,
+    /// Index in the plan.
+    pub index: usize,
+    /// Strain z = (s_x, s_a, s_y, Π₀₀, Π₁₁).
+    pub z: [f64; 5],
+    /// Ψ̄ (J/m²) when converged, else null.
+    pub psi: Option<f64>,
+    /// Envelope-theorem stress ∂Ψ̄/∂z (J/m² per unit strain) when converged; a component not defined in the
+    /// solve's family is null.
+    pub stress: Option<[Option<f64>; 5]>,
+    /// `Converged`, `Stalled`, `MaxSteps`, `TimeLimit`, or `Error` (see `error`).
+    pub status: String,
+    /// Why the solve could not run (bad strain, overlapping yarns, failed factorisation).
+    pub error: Option<String>,
+    /// Newton steps.
+    pub steps: usize,
+    /// Final ‖g‖∞ (N), null on error.
+    pub gradient_norm: Option<f64>,
+    /// Wall time of the solve (s).
+    pub time: f64,
+    /// How the solve started: `cold`, `warm` (previous equilibrium) or `predicted` (secant predictor).
+    pub start: String,
+    /// Hash of (pattern, yarn parameters, solver settings), 16 hex digits ([`problem_hash`]).
+    pub problem: String,
+}
+
+/// Options of [`run_plan`].
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    /// Start every sample from the reference state.
+    pub cold: bool,
+    /// Run shard k of n (k < n).
+    pub shard: Option<(usize, usize)>,
+    /// Stop after writing this many samples.
+    pub limit: Option<usize>,
+    /// Show a progress bar on stderr.
+    pub progress: bool,
+}
+
+/// What a run did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RunSummary {
+    /// Samples in the selected chains.
+    pub selected: usize,
+    /// Of these, already in the file at the start.
+    pub already_done: usize,
+    /// Records written by this run.
+    pub written: usize,
+    /// Of these, converged.
+    pub converged: usize,
+    /// Solves redone (not written) to recover warm-start states of finished samples.
+    pub replayed: usize,
+    /// Wall time (s).
+    pub time: f64,
+}
+
+/// Hash of (pattern, yarn parameters, solver settings): FNV-1a 64 of the `.pyp` text, the yarn material and the
+/// solver options as JSON, as 16 hex digits.
+pub fn problem_hash(problem: &MicroProblem) -> String {
+    let text = format!(
+        "{}\n{:?}\n{}",
+        problem.pattern.to_pyp_string(),
+        problem.material,
+        serde_json::to_string(&problem.options).unwrap_or_default()
+    );
+    format!("{:016x}", fnv1a64(text.as_bytes()))
+}
+
+/// Parse `k/n` (0 ≤ k < n).
+pub fn parse_shard(text: &str) -> Result<(usize, usize), String> {
+    let bad = || format!("--shard: expected k/n with 0 ≤ k < n, got {text:?}");
+    let (k, n) = text.split_once('/').ok_or_else(bad)?;
+    let k: usize = k.trim().parse().map_err(|_| bad())?;
+    let n: usize = n.trim().parse().map_err(|_| bad())?;
+    if n == 0 || k >= n {
+        return Err(bad());
+    }
+    Ok((k, n))
+}
+
+/// Read a sample file: its records, in file order. A last line without its newline (an interrupted write) is
+/// ignored, and with `repair` cut off the file; any other unreadable line is an error naming file and line.
+pub fn read_samples(path: &Path, repair: bool) -> Result<Vec<Record>, String> {
+    let name = path.display();
+    let text = match std::fs::read(path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(vec![]),
+        Err(e) => return Err(format!("{name}: cannot read: {e}")),
+    };
+    let complete = text.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
+    if complete < text.len() && repair {
+        let f = OpenOptions::new()
+            .write(true)
+            .open(path)
+            .map_err(|e| format!("{name}: cannot open to cut off the truncated last line: {e}"))?;
+        f.set_len(complete as u64)
+            .and_then(|_| f.sync_data())
+            .map_err(|e| format!("{name}: cannot cut off the truncated last line: {e}"))?;
+    }
+    let text = std::str::from_utf8(&text[..complete])
+        .map_err(|e| format!("{name}: not UTF-8 text: {e}"))?;
+    let mut out = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let r: Record = serde_json::from_str(line)
+            .map_err(|e| format!("{name}:{}: not a sample record: {e}", i + 1))?;
+        out.push(r);
+    }
+    Ok(out)
+}
+
+/// Append one record as a single write of the full line, then sync it to disk.
+fn append(file: &Mutex<File>, record: &Record) -> Result<(), String> {
+    let mut line = serde_json::to_string(record).map_err(|e| e.to_string())?;
+    line.push('\n');
+    let mut f = file
+        .lock()
+        .map_err(|_| "sample file lock poisoned".to_string())?;
+    f.write_all(line.as_bytes())
+        .and_then(|_| f.sync_data())
+        .map_err(|e| format!("cannot append to the sample file: {e}"))
+}
+
+/// Run `plan` on `problem`, appending to the sample file `out` (created if missing; finished ids skipped).
+pub fn run_plan(
+    problem: &MicroProblem,
+    plan: &Plan,
+    out: &Path,
+    opts: &RunOptions,
+) -> Result<RunSummary, String> {
+    let t0 = Instant::now();
+    plan.validate().map_err(|e| e.to_string())?;
+    let hash = problem_hash(problem);
+    let existing = read_samples(out, true)?;
+    if let Some(r) = existing.iter().find(|r| r.problem != hash) {
+        return Err(format!(
+            "{}: sample {} was solved for another problem (hash {}, this run {hash}): \
+             pattern, yarn parameters or solver settings differ",
+            out.display(),
+            r.id,
+            r.problem
+        ));
+    }
+    let done: HashSet<String> = existing.into_iter().map(|r| r.id).collect();
+    let samples = plan.samples();
+    let chains: Vec<_> = plan
+        .chains()
+        .into_iter()
+        .enumerate()
+        .filter(|(c, _)| opts.shard.is_none_or(|(k, n)| c % n == k))
+        .map(|(_, c)| c)
+        .collect();
+    let selected: usize = chains.iter().map(|c| c.steps.len()).sum();
+    let already_done = chains
+        .iter()
+        .flat_map(|c| &c.steps)
+        .filter(|s| done.contains(&samples[s.sample].id))
+        .count();
+    let todo = selected - already_done;
+    let todo = opts.limit.map_or(todo, |l| l.min(todo));
+
+    let file = OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(out)
+        .map_err(|e| format!("{}: cannot open for appending: {e}", out.display()))?;
+    let file = Mutex::new(file);
+    let bar = if opts.progress {
+        let b = ProgressBar::new(todo as u64);
+        if let Ok(style) = ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {pos}/{len} samples, {per_sec}, eta {eta}",
+        ) {
+            b.set_style(style);
+        }
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let written = AtomicUsize::new(0);
+    let slots = AtomicUsize::new(0);
+    let converged = AtomicUsize::new(0);
+    let replayed = AtomicUsize::new(0);
+    let stop = AtomicBool::new(false);
+    let failure: Mutex<Option<String>> = Mutex::new(None);
+
+    chains.par_iter().for_each(|chain| {
+        let steps = &chain.steps;
+        // which steps to solve: unfinished ones and (warm) every step they continue from
+        let mut need: Vec<bool> = steps
+            .iter()
+            .map(|s| !done.contains(&samples[s.sample].id))
+            .collect();
+        if !opts.cold {
+            for i in (0..steps.len()).rev() {
+                if need[i] {
+                    if let Some(f) = steps[i].from {
+                        need[f] = true;
+                    }
+                }
+            }
+        }
+        let mut states: Vec<Option<MicroState>> = vec![None; steps.len()];
+        for (i, step) in steps.iter().enumerate() {
+            if !need[i] || stop.load(Ordering::Relaxed) {
+                continue;
+            }
+            let sample = &samples[step.sample];
+            let write = !done.contains(&sample.id);
+            if write
+                && opts
+                    .limit
+                    .is_some_and(|l| slots.fetch_add(1, Ordering::SeqCst) >= l)
+            {
+                stop.store(true, Ordering::Relaxed);
+                break;
+            }
+            let strain = MacroStrain(sample.z);
+            // the nearest converged step up the chain, and its own converged predecessor
+            let mut a = if opts.cold { None } else { step.from };
+            while let Some(k) = a {
+                if states[k].is_some() {
+                    break;
+                }
+                a = steps[k].from;
+            }
+            let b = a
+                .and_then(|k| steps[k].from)
+                .filter(|&k| states[k].is_some());
+            let mut how = "cold";
+            let predicted = match (a, b) {
+                (Some(a), Some(b)) => match (&states[b], &states[a]) {
+                    (Some(sb), Some(sa)) => problem.predict(sb, sa, &strain).ok().flatten(),
+                    _ => None,
+                },
+                _ => None,
+            };
+            let start = if let Some(p) = predicted.as_ref() {
+                how = "predicted";
+                Some(p)
+            } else if let Some(s) = a.and_then(|a| states[a].as_ref()) {
+                how = "warm";
+                Some(s)
+            } else {
+                None
+            };
+            let t = Instant::now();
+            let result = problem.solve(&strain, start);
+            let record = match result {
+                Ok(sol) => {
+                    let ok = sol.status == Status::Converged;
+                    let stress = if ok {
+                        strain_derivatives(problem, &sol.state).ok()
+                    } else {
+                        None
+                    };
+                    let r = Record {
+                        id: sample.id.clone(),
+                        index: sample.index,
+                        z: sample.z,
+                        psi: sol.psi().ok(),
+                        stress,
+                        status: sol.status.to_string(),
+                        error: None,
+                        steps: sol.steps,
+                        gradient_norm: Some(sol.gradient_norm).filter(|g| g.is_finite()),
+                        time: sol.time,
+                        start: how.into(),
+                        problem: hash.clone(),
+                    };
+                    if ok {
+                        states[i] = Some(sol.state);
+                    }
+                    r
+                }
+                Err(e) => Record {
+                    id: sample.id.clone(),
+                    index: sample.index,
+                    z: sample.z,
+                    psi: None,
+                    stress: None,
+                    status: "Error".into(),
+                    error: Some(e.to_string()),
+                    steps: 0,
+                    gradient_norm: None,
+                    time: t.elapsed().as_secs_f64(),
+                    start: how.into(),
+                    problem: hash.clone(),
+                },
+            };
+            if write {
+                if let Err(e) = append(&file, &record) {
+                    if let Ok(mut f) = failure.lock() {
+                        f.get_or_insert(e);
+                    }
+                    stop.store(true, Ordering::Relaxed);
+                    break;
+                }
+                written.fetch_add(1, Ordering::Relaxed);
+                if record.psi.is_some() {
+                    converged.fetch_add(1, Ordering::Relaxed);
+                }
+                bar.inc(1);
+            } else {
+                replayed.fetch_add(1, Ordering::Relaxed);
+            }
+        }
+    });
+    bar.finish_and_clear();
+    if let Some(e) = failure.into_inner().ok().flatten() {
+        return Err(format!("{}: {e}", out.display()));
+    }
+    Ok(RunSummary {
+        selected,
+        already_done,
+        written: written.into_inner(),
+        converged: converged.into_inner(),
+        replayed: replayed.into_inner(),
+        time: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// Merge sample files (e.g. shards) into `out`: all records, the first of each id kept, ordered by plan index then
+/// id. Returns (records written, duplicates dropped). `out` is written to a temporary file and renamed.
+pub fn merge(out: &Path, inputs: &[&Path]) -> Result<(usize, usize), String> {
+    let mut seen = HashSet::new();
+    let mut records = Vec::new();
+    let mut duplicates = 0;
+    for path in inputs {
+        for r in read_samples(path, false)? {
+            if seen.insert(r.id.clone()) {
+                records.push(r);
+            } else {
+                duplicates += 1;
+            }
+        }
+    }
+    records.sort_by(|a, b| a.index.cmp(&b.index).then_with(|| a.id.cmp(&b.id)));
+    let mut text = String::new();
+    for r in &records {
+        text.push_str(&serde_json::to_string(r).map_err(|e| e.to_string())?);
+        text.push('\n');
+    }
+    let tmp = out.with_extension("merge-tmp");
+    std::fs::write(&tmp, text)
+        .and_then(|_| std::fs::rename(&tmp, out))
+        .map_err(|e| format!("{}: cannot write: {e}", out.display()))?;
+    Ok((records.len(), duplicates))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shard_parsing() {
+        assert_eq!(parse_shard("0/2"), Ok((0, 2)));
+        assert_eq!(parse_shard(" 3 / 4 "), Ok((3, 4)));
+        for bad in ["2/2", "1", "a/b", "0/0", "-1/2"] {
+            assert!(parse_shard(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn truncated_last_line_is_cut_off() {
+        let dir = std::env::temp_dir().join(format!("hylc-sample-unit-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("s.jsonl");
+        let r = Record {
+            id: "x-0".into(),
+            index: 0,
+            z: [0.1, 0.0, 0.0, 0.0, 0.0],
+            psi: Some(1.0 / 3.0),
+            stress: Some([Some(0.5), None, Some(0.0), Some(-1e-300), None]),
+            status: "Converged".into(),
+            error: None,
+            steps: 3,
+            gradient_norm: Some(1e-12),
+            time: 0.01,
+            start: "cold".into(),
+            problem: "0".into(),
+        };
+        let line = serde_json::to_string(&r).unwrap();
+        std::fs::write(&path, format!("{line}\n{}", &line[..20])).unwrap();
+        assert_eq!(read_samples(&path, false).unwrap(), vec![r.clone()]);
+        assert_eq!(read_samples(&path, true).unwrap(), vec![r.clone()]);
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), format!("{line}\n"));
+        std::fs::write(&path, format!("{}\n{line}\n", &line[..20])).unwrap();
+        let e = read_samples(&path, false).unwrap_err();
+        assert!(e.contains("s.jsonl:1"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
