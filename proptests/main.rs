@@ -6,6 +6,7 @@
 //! |II| up to 1e4.
 
 mod contact;
+mod fit;
 mod micro;
 mod rod;
 

@@ -6,6 +6,7 @@
 
 pub mod contact;
 pub mod diff;
+pub mod fit;
 pub mod material;
 pub mod micro;
 pub mod pattern;

@@ -1,0 +1,372 @@
+//! FIT1D (`04-sampling-fitting.md`, "Fitting (C5, C6, C7)", steps 1–6): one 1D term f_k of the material from
+//! samples (X, Ψ) of its 1D strain range (X already normalised by the strain scale).
+//!
+//! 1. g(u) = symexp(MLS(u | X, symlog Ψ)), ε = `eps_rel` · max|Ψ|; symmetrised MLS for s_a.
+//! 2. Knots: all multiples of h = 0.95 (max X − min X)/(N_c − 1) inside [0.95 min X, 0.95 max X]; values p = g(t),
+//!    slopes pˣ by central finite differences of g (step `fd_step` · h).
+//! 3. Quasi-convexification marching outward from i_min (the knot at 0, or argmin p): p_{i+1} ≥ pᵢ + (t_{i+1} − tᵢ)
+//!    pˣ_min and pˣᵢ ≥ pˣ_min on the right, mirrored on the left.
+//! 4. Fritsch–Carlson (1980) monotone correction on each side of i_min. We use their sufficient region
+//!    0 ≤ α, β ≤ 3 (α, β = slope / secant of a cell), clamping each slope to ≤ 3 |secant| of both adjacent cells;
+//!    unlike the radial rescaling this never lowers a slope below 3 pˣ_min, so step 3's slope bound survives.
+//! 5. Increasing extrapolation: the end slopes are clamped to ≤ −pˣ_min (left) and ≥ pˣ_min (right), so the
+//!    linear continuation keeps rising away from the minimum.
+//! 6. Residual: p ← p − f(0); the removed constant is returned as [`Fit1D::offset`] (it belongs to f₀).
+//!
+//! The slope at i_min itself is only limited by step 4 on the side its sign points to; the cell on the other side
+//! then has slopes of opposite signs at its ends, and a cubic Hermite cell whose end slopes are (−, +) has a
+//! quadratic derivative with exactly one root in the cell, so the spline stays quasi-convex (its minimum may sit
+//! slightly off the knot).
+
+use super::mls::{Mls1D, DEFAULT_BANDWIDTH_FACTOR};
+use super::symlog::{symexp, symlog};
+use super::FitError;
+use crate::material::Hermite1D;
+
+/// Where the minimum knot i_min is (step 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MinimumAt {
+    /// the knot at 0 (in-plane strains s_x, s_a, s_y)
+    Zero,
+    /// the knot with the smallest value p (bending)
+    Argmin,
+}
+
+/// FIT1D parameters; [`Default`] gives the design's defaults for an in-plane strain.
+#[derive(Clone, Debug)]
+pub struct Fit1DOptions {
+    /// N_c, the knot count that sets the spacing h (default 11)
+    pub n_knots: usize,
+    /// MLS bandwidth in median sample spacings (default 2)
+    pub bandwidth_factor: f64,
+    /// ε = eps_rel · max|Ψ| in symlog (default 1e-3)
+    pub eps_rel: f64,
+    /// pˣ_min (default 0.001; 0.01 for stockinette-like patterns); must be > 0 so every cell off i_min has a
+    /// non-zero secant
+    pub min_slope: f64,
+    /// use ½(MLS(u) + MLS(−u)) (the shear strain s_a)
+    pub symmetric: bool,
+    /// i_min rule (default the knot at 0)
+    pub minimum: MinimumAt,
+    /// central-difference step for the slopes, as a fraction of h (default 1e-3)
+    pub fd_step: f64,
+}
+
+impl Default for Fit1DOptions {
+    fn default() -> Self {
+        Fit1DOptions {
+            n_knots: 11,
+            bandwidth_factor: DEFAULT_BANDWIDTH_FACTOR,
+            eps_rel: 1e-3,
+            min_slope: 1e-3,
+            symmetric: false,
+            minimum: MinimumAt::Zero,
+            fd_step: 1e-3,
+        }
+    }
+}
+
+/// Fit quality at the samples the term was fitted to (the spline plus [`Fit1D::offset`] against Ψ).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fit1DReport {
+    /// samples used
+    pub n_samples: usize,
+    /// samples excluded because X or Ψ is not finite (failed solves)
+    pub n_excluded: usize,
+    /// √(Σ e²) / √(Σ Ψ²) over the used samples (e = fit − Ψ)
+    pub rms_rel: f64,
+    /// max |e| / max |Ψ|
+    pub max_rel: f64,
+    /// index of the minimum knot i_min
+    pub i_min: usize,
+}
+
+/// A fitted 1D term: the residual spline (value 0 at x = 0), the constant removed in step 6, and the report.
+#[derive(Clone, Debug)]
+pub struct Fit1D {
+    pub spline: Hermite1D,
+    pub offset: f64,
+    pub report: Fit1DReport,
+}
+
+fn check_options(o: &Fit1DOptions) -> Result<(), FitError> {
+    let bad = |s: String| Err(FitError::BadOption(s));
+    if o.n_knots < 2 {
+        return bad(format!("n_knots = {} (need ≥ 2)", o.n_knots));
+    }
+    if !(o.eps_rel.is_finite() && o.eps_rel > 0.0) {
+        return bad(format!("eps_rel = {} (need finite, > 0)", o.eps_rel));
+    }
+    if !(o.min_slope.is_finite() && o.min_slope > 0.0) {
+        return bad(format!("min_slope = {} (need finite, > 0)", o.min_slope));
+    }
+    if !(o.fd_step.is_finite() && o.fd_step > 0.0 && o.fd_step <= 0.5) {
+        return bad(format!("fd_step = {} (need in (0, 0.5])", o.fd_step));
+    }
+    Ok(())
+}
+
+/// FIT1D on samples `x` (normalised strain) and `psi` (energy density). Samples where either is not finite are
+/// excluded and counted. Errors: length mismatch, fewer than three distinct usable abscissae, invalid options, fewer
+/// than two knots, or no knot at 0 when [`MinimumAt::Zero`] (the data must straddle 0).
+pub fn fit1d(x: &[f64], psi: &[f64], opts: &Fit1DOptions) -> Result<Fit1D, FitError> {
+    if x.len() != psi.len() {
+        return Err(FitError::LengthMismatch {
+            x: x.len(),
+            psi: psi.len(),
+        });
+    }
+    check_options(opts)?;
+    let (xs, ys): (Vec<f64>, Vec<f64>) = x
+        .iter()
+        .zip(psi)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(&a, &b)| (a, b))
+        .unzip();
+    let n_excluded = x.len() - xs.len();
+
+    // step 1: g = symexp ∘ MLS ∘ symlog
+    let psi_max = ys.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let eps = if psi_max > 0.0 {
+        opts.eps_rel * psi_max
+    } else {
+        1.0
+    };
+    let logs: Vec<f64> = ys.iter().map(|&v| symlog(v, eps)).collect();
+    let mls = Mls1D::new(&xs, &logs, opts.bandwidth_factor)?;
+    let g = |u: f64| {
+        let w = if opts.symmetric {
+            mls.eval_symmetric(u)
+        } else {
+            mls.eval(u)
+        };
+        symexp(w, eps)
+    };
+
+    // step 2: knots at multiples of h inside [0.95 min X, 0.95 max X]
+    let (lo, hi) = xs
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
+    let h = 0.95 * (hi - lo) / (opts.n_knots - 1) as f64;
+    // a relative tolerance keeps a multiple that lands on the bound despite rounding
+    let k_lo = (0.95 * lo / h - 1e-9).ceil() as i64;
+    let k_hi = (0.95 * hi / h + 1e-9).floor() as i64;
+    if k_hi - k_lo < 1 {
+        return Err(FitError::Knots(format!(
+            "fewer than two multiples of h = {h} in [{}, {}]",
+            0.95 * lo,
+            0.95 * hi
+        )));
+    }
+    let t: Vec<f64> = (k_lo..=k_hi).map(|k| k as f64 * h).collect();
+    let mut p: Vec<f64> = t.iter().map(|&u| g(u)).collect();
+    let d = opts.fd_step * h;
+    let mut m: Vec<f64> = t
+        .iter()
+        .map(|&u| (g(u + d) - g(u - d)) / (2.0 * d))
+        .collect();
+    if p.iter().chain(&m).any(|v| !v.is_finite()) {
+        return Err(FitError::BadOption(
+            "the MLS curve overflowed (Ψ too large for symexp)".into(),
+        ));
+    }
+    let n = t.len();
+
+    // step 3: quasi-convexify outward from i_min
+    let i_min = match opts.minimum {
+        MinimumAt::Zero => {
+            if k_lo > 0 || k_hi < 0 {
+                return Err(FitError::Knots(format!(
+                    "no knot at 0: the samples span [{lo}, {hi}]"
+                )));
+            }
+            (-k_lo) as usize
+        }
+        MinimumAt::Argmin => (0..n).fold(0, |b, i| if p[i] < p[b] { i } else { b }),
+    };
+    let pmin = opts.min_slope;
+    for i in i_min + 1..n {
+        p[i] = p[i].max(p[i - 1] + (t[i] - t[i - 1]) * pmin);
+        m[i] = m[i].max(pmin);
+    }
+    for i in (0..i_min).rev() {
+        p[i] = p[i].max(p[i + 1] + (t[i + 1] - t[i]) * pmin);
+        m[i] = m[i].min(-pmin);
+    }
+
+    // step 5 (before 4, which never changes a slope's sign or lowers |slope| below 3 pˣ_min): end slopes rise outward
+    m[n - 1] = m[n - 1].max(pmin);
+    m[0] = m[0].min(-pmin);
+
+    // step 4: Fritsch–Carlson, 0 ≤ α, β ≤ 3 on every cell, sides of i_min separately
+    for c in 0..n - 1 {
+        let secant = (p[c + 1] - p[c]) / (t[c + 1] - t[c]);
+        let cap = 3.0 * secant.abs();
+        for i in [c, c + 1] {
+            // limit only slopes pointing the way the cell goes; the (−, +) cell at i_min is left as it is
+            if m[i] * secant > 0.0 && m[i].abs() > cap {
+                m[i] = cap.copysign(m[i]);
+            }
+        }
+    }
+
+    // step 6: residual form
+    let spline = Hermite1D::new(t, p, m);
+    // at the knot 0 (always there for in-plane strains) take its value exactly, else evaluate (extrapolating)
+    let offset = match spline.t.iter().position(|&v| v == 0.0) {
+        Some(i) => spline.p[i],
+        None => spline.eval2(0.0)[0],
+    };
+    let t = spline.t.clone();
+    let p: Vec<f64> = spline.p.iter().map(|v| v - offset).collect();
+    let m = spline.m.clone();
+    let spline = Hermite1D::new(t, p, m);
+
+    // report
+    let (mut se, mut sp, mut emax) = (0.0f64, 0.0f64, 0.0f64);
+    for (&xv, &yv) in xs.iter().zip(&ys) {
+        let e = spline.eval2(xv)[0] + offset - yv;
+        se += e * e;
+        sp += yv * yv;
+        emax = emax.max(e.abs());
+    }
+    let report = Fit1DReport {
+        n_samples: xs.len(),
+        n_excluded,
+        rms_rel: if sp > 0.0 {
+            (se / sp).sqrt()
+        } else {
+            se.sqrt()
+        },
+        max_rel: if psi_max > 0.0 { emax / psi_max } else { emax },
+        i_min,
+    };
+    Ok(Fit1D {
+        spline,
+        offset,
+        report,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn samples(f: impl Fn(f64) -> f64, lo: f64, hi: f64, n: usize) -> (Vec<f64>, Vec<f64>) {
+        let x: Vec<f64> = (0..n)
+            .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
+            .collect();
+        let y = x.iter().map(|&v| f(v)).collect();
+        (x, y)
+    }
+
+    #[test]
+    fn knots_are_multiples_of_h_with_zero() {
+        let (x, y) = samples(|v| v * v, -0.5, 1.0, 61);
+        let fit = fit1d(&x, &y, &Fit1DOptions::default()).unwrap();
+        let h = 0.95 * 1.5 / 10.0;
+        let t = &fit.spline.t;
+        assert!(t
+            .iter()
+            .all(|&v| (0.95 * -0.5 - 1e-12..=0.95 + 1e-12).contains(&v)));
+        for (i, v) in t.iter().enumerate() {
+            assert!(((v / h) - (v / h).round()).abs() < 1e-9, "knot {i} = {v}");
+        }
+        assert_eq!(t[fit.report.i_min], 0.0);
+        assert_eq!(fit.spline.p[fit.report.i_min], 0.0);
+        // multiples k h with k = −3..=6 (0.95 · −0.5 / h = −3.33, 0.95 / h = 6.67)
+        assert_eq!(t.len(), 10);
+        assert!((t[0] + 3.0 * h).abs() < 1e-15 && (t[9] - 6.0 * h).abs() < 1e-15);
+    }
+
+    #[test]
+    fn nan_samples_are_excluded_and_counted() {
+        let (mut x, mut y) = samples(|v| v * v + v.powi(4), -1.0, 1.0, 81);
+        y[3] = f64::NAN;
+        x[10] = f64::INFINITY;
+        let fit = fit1d(&x, &y, &Fit1DOptions::default()).unwrap();
+        assert_eq!(fit.report.n_excluded, 2);
+        assert_eq!(fit.report.n_samples, 79);
+        assert!(fit.report.max_rel < 1e-2, "{:?}", fit.report);
+    }
+
+    #[test]
+    fn bad_input_is_an_error_not_a_panic() {
+        let o = Fit1DOptions::default();
+        assert!(fit1d(&[0.0, 1.0], &[0.0], &o).is_err());
+        assert!(matches!(
+            fit1d(&[0.0, 1.0, f64::NAN], &[0.0, 1.0, 2.0], &o),
+            Err(FitError::TooFewSamples { .. })
+        ));
+        // no knot at 0 for an in-plane strain
+        let (x, y) = samples(|v| v * v, 0.5, 1.0, 20);
+        assert!(matches!(fit1d(&x, &y, &o), Err(FitError::Knots(_))));
+        // but fine for bending (argmin)
+        let ob = Fit1DOptions {
+            minimum: MinimumAt::Argmin,
+            ..o.clone()
+        };
+        let (x, y) = samples(|v| (v - 3.0).powi(2), 2.0, 4.0, 201);
+        let fit = fit1d(&x, &y, &ob).unwrap();
+        // knots span [1.9, 3.8]; the linear extrapolation to X = 4 costs ≈ 4 % of max Ψ there
+        assert!(fit.report.max_rel < 0.05, "{:?}", fit.report);
+        let s = &fit.spline;
+        // (0.95 min X = 1.9 lies outside the data, so the first knot is an MLS extrapolation: skip it)
+        for i in (0..s.t.len()).filter(|&i| s.t[i] >= 2.0) {
+            // (3e-3 of max Ψ = 1: near the zero minimum symlog is sharp on the 0.01 sample spacing)
+            // p is residual: the offset f(0) (from the linear extrapolation to 0) goes back in
+            let want = (s.t[i] - 3.0).powi(2);
+            let got = s.p[i] + fit.offset;
+            assert!(
+                (got - want).abs() < 3e-3,
+                "knot {}: {got} vs {want}",
+                s.t[i]
+            );
+        }
+        for bad in [
+            Fit1DOptions {
+                n_knots: 1,
+                ..o.clone()
+            },
+            Fit1DOptions {
+                eps_rel: 0.0,
+                ..o.clone()
+            },
+            Fit1DOptions {
+                min_slope: f64::NAN,
+                ..o.clone()
+            },
+            Fit1DOptions {
+                fd_step: 0.0,
+                ..o.clone()
+            },
+            Fit1DOptions {
+                bandwidth_factor: -1.0,
+                ..o.clone()
+            },
+        ] {
+            assert!(matches!(fit1d(&x, &y, &bad), Err(FitError::BadOption(_))));
+        }
+    }
+
+    #[test]
+    fn shear_fit_is_even() {
+        let (x, y) = samples(
+            |v| 2.0 * v * v + 0.3 * v.powi(3) + v.powi(4),
+            -1.0,
+            1.0,
+            101,
+        );
+        let o = Fit1DOptions {
+            symmetric: true,
+            ..Fit1DOptions::default()
+        };
+        let s = fit1d(&x, &y, &o).unwrap().spline;
+        for u in [0.1, 0.37, 0.8] {
+            let (a, b) = (s.eval2(u)[0], s.eval2(-u)[0]);
+            assert!((a - b).abs() < 1e-9 * a.abs(), "{u}: {a} vs {b}");
+        }
+    }
+}
