@@ -31,12 +31,7 @@ fn patterns() -> Vec<(String, Pattern)> {
                 "cartridge_belt_rib",
             ] {
                 let path = dir.join(format!("data/hylc2020/patterns/{name}.pyp"));
-                if let Ok((mut p, w)) = Pattern::load_pyp(&path) {
-                    if !w.is_empty() {
-                        if let Some(implied) = p.implied_periods() {
-                            p.periods = implied;
-                        }
-                    }
+                if let Ok((p, _)) = Pattern::load_pyp_at_implied_periods(&path) {
                     v.push((name.to_string(), p));
                 }
             }

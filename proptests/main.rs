@@ -7,6 +7,7 @@
 
 mod contact;
 mod fit;
+mod fit2d;
 mod micro;
 mod rod;
 

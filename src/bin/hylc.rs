@@ -2,6 +2,8 @@
 
 #[path = "hylc/calibrate.rs"]
 mod calibrate;
+#[path = "hylc/fit.rs"]
+mod fit;
 #[path = "hylc/micro.rs"]
 mod micro;
 #[path = "hylc/micro_grid.rs"]
@@ -189,6 +191,59 @@ enum Command {
         /// the reduced plan (30 per 1D range, 10×10 grids)
         #[arg(long)]
         reduced: bool,
+        /// the held-out plan: only the 9×9×9 in-plane grid of the original displacement data
+        #[arg(long)]
+        holdout: bool,
+    },
+    /// Fit a material (Algorithm C5) to a sample file; writes the material JSON, a JSON fit report and PNG plots.
+    Fit {
+        /// sample file (JSON lines from `hylc sample`)
+        samples: PathBuf,
+        /// material file to write (default: SAMPLES with extension .material.json)
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// JSON fit report (default: SAMPLES with extension .fit.json)
+        #[arg(long)]
+        report: Option<PathBuf>,
+        /// folder for the PNG plots (default: SAMPLES with extension .plots)
+        #[arg(long)]
+        plots: Option<PathBuf>,
+        /// skip the plots
+        #[arg(long)]
+        no_plots: bool,
+        /// the plan of the samples (default: the sidecar's, or the built-in plan the ids name)
+        #[arg(long)]
+        plan: Option<String>,
+        /// areal density ρ_A in kg/m² (default: the sidecar's)
+        #[arg(long)]
+        density: Option<f64>,
+        /// held-out sample file(s) whose Ψ̄ the model must predict (e.g. from `--plan holdout`)
+        #[arg(long)]
+        holdout: Vec<PathBuf>,
+        /// compare the fitted 1D curves f₀ + f_k with another material file (e.g. the original's)
+        #[arg(long)]
+        compare: Option<PathBuf>,
+        /// the stockinette settings of the design: pˣ_min = 0.01, 2D knots on 0.3 of the range
+        #[arg(long)]
+        stockinette_like: bool,
+        /// knots of each 1D term (N_c)
+        #[arg(long, default_value_t = 11)]
+        knots_1d: usize,
+        /// knots per axis of each 2D term
+        #[arg(long, default_value_t = 9)]
+        knots_2d: usize,
+        /// minimum slope pˣ_min (default 0.001, or 0.01 with --stockinette-like)
+        #[arg(long)]
+        min_slope: Option<f64>,
+        /// extent of the 2D knots as a fraction of the data range (default 0.9, or 0.3 with --stockinette-like)
+        #[arg(long)]
+        extent: Option<f64>,
+        /// slopes of the 1D terms: fd (finite differences of the MLS) or stress (MLS of the sampled stresses)
+        #[arg(long, default_value = "fd")]
+        slopes: String,
+        /// fit the 1D terms to every K-th sample of their ranges only (the others are held out)
+        #[arg(long, default_value_t = 1, value_name = "K")]
+        thin_1d: usize,
     },
     /// Compute the reference state of a pattern (Algorithm C1: stress-free state, tension, zero-stress periods,
     /// centring) and write it as `.pyp`.
@@ -375,9 +430,63 @@ fn main() -> ExitCode {
         Command::Merge { out, inputs } => {
             sample::merge_cmd(&out, &inputs).map(|_| ExitCode::SUCCESS)
         }
-        Command::Plan { write, reduced } => {
-            sample::plan_cmd(&write, reduced).map(|_| ExitCode::SUCCESS)
-        }
+        Command::Plan {
+            write,
+            reduced,
+            holdout,
+        } => sample::plan_cmd(&write, reduced, holdout).map(|_| ExitCode::SUCCESS),
+        Command::Fit {
+            samples,
+            out,
+            report,
+            plots,
+            no_plots,
+            plan,
+            density,
+            holdout,
+            compare,
+            stockinette_like,
+            knots_1d,
+            knots_2d,
+            min_slope,
+            extent,
+            slopes,
+            thin_1d,
+        } => (|| {
+            let mut options = if stockinette_like {
+                hylc::fit::FitOptions::stockinette_like()
+            } else {
+                hylc::fit::FitOptions::default()
+            };
+            options.n_knots_1d = knots_1d;
+            options.n_knots_2d = knots_2d;
+            if let Some(m) = min_slope {
+                options.min_slope = m;
+            }
+            if let Some(e) = extent {
+                options.extent_2d = e;
+            }
+            options.slopes = fit::parse_slopes(&slopes)?;
+            options.thin_1d = thin_1d.max(1);
+            let out = out.unwrap_or_else(|| samples.with_extension("material.json"));
+            let report = report.unwrap_or_else(|| samples.with_extension("fit.json"));
+            let plots = plots.unwrap_or_else(|| samples.with_extension("plots"));
+            fit::fit(
+                &samples,
+                &out,
+                &report,
+                &plots,
+                fit::FitArgs {
+                    plan,
+                    density,
+                    holdout,
+                    compare,
+                    options,
+                    plots: !no_plots,
+                },
+            )
+        })()
+        .map(|_| ExitCode::SUCCESS),
         Command::Solve {
             pattern,
             z,

@@ -32,6 +32,15 @@ pub enum MinimumAt {
     Argmin,
 }
 
+/// Where the knot slopes pˣ come from (step 2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SlopeSource {
+    /// central differences of g (the original's choice)
+    FiniteDifference,
+    /// the MLS of the sampled stresses dΨ/dX (envelope theorem), odd-symmetrised for s_a; needs the stresses
+    Stress,
+}
+
 /// FIT1D parameters; [`Default`] gives the design's defaults for an in-plane strain.
 #[derive(Clone, Debug)]
 pub struct Fit1DOptions {
@@ -50,6 +59,8 @@ pub struct Fit1DOptions {
     pub minimum: MinimumAt,
     /// central-difference step for the slopes, as a fraction of h (default 1e-3)
     pub fd_step: f64,
+    /// slope source (default finite differences)
+    pub slopes: SlopeSource,
 }
 
 impl Default for Fit1DOptions {
@@ -62,6 +73,7 @@ impl Default for Fit1DOptions {
             symmetric: false,
             minimum: MinimumAt::Zero,
             fd_step: 1e-3,
+            slopes: SlopeSource::FiniteDifference,
         }
     }
 }
@@ -87,6 +99,8 @@ pub struct Fit1D {
     pub spline: Hermite1D,
     pub offset: f64,
     pub report: Fit1DReport,
+    /// the smoothed curve g of step 1 at 201 points over the samples' range (for plots)
+    pub curve: Vec<[f64; 2]>,
 }
 
 fn check_options(o: &Fit1DOptions) -> Result<(), FitError> {
@@ -110,6 +124,31 @@ fn check_options(o: &Fit1DOptions) -> Result<(), FitError> {
 /// excluded and counted. Errors: length mismatch, fewer than three distinct usable abscissae, invalid options, fewer
 /// than two knots, or no knot at 0 when [`MinimumAt::Zero`] (the data must straddle 0).
 pub fn fit1d(x: &[f64], psi: &[f64], opts: &Fit1DOptions) -> Result<Fit1D, FitError> {
+    fit1d_with_stress(x, psi, None, opts)
+}
+
+/// [`fit1d`] with the sampled stresses dΨ/dX (same length as `x`; non-finite entries are dropped with their
+/// sample), used for the slopes when `opts.slopes` is [`SlopeSource::Stress`]: pˣ = MLS(t | X, dΨ/dX), the odd part
+/// ½(MLS(t) − MLS(−t)) for s_a. An error when stresses are asked for but not given.
+pub fn fit1d_with_stress(
+    x: &[f64],
+    psi: &[f64],
+    stress: Option<&[f64]>,
+    opts: &Fit1DOptions,
+) -> Result<Fit1D, FitError> {
+    if let Some(st) = stress {
+        if st.len() != x.len() {
+            return Err(FitError::LengthMismatch {
+                x: x.len(),
+                psi: st.len(),
+            });
+        }
+    }
+    if opts.slopes == SlopeSource::Stress && stress.is_none() {
+        return Err(FitError::BadOption(
+            "slopes from stresses asked for, but the samples carry no stresses".into(),
+        ));
+    }
     if x.len() != psi.len() {
         return Err(FitError::LengthMismatch {
             x: x.len(),
@@ -161,12 +200,36 @@ pub fn fit1d(x: &[f64], psi: &[f64], opts: &Fit1DOptions) -> Result<Fit1D, FitEr
         )));
     }
     let t: Vec<f64> = (k_lo..=k_hi).map(|k| k as f64 * h).collect();
+    let curve: Vec<[f64; 2]> = (0..=200)
+        .map(|i| {
+            let u = lo + (hi - lo) * i as f64 / 200.0;
+            [u, g(u)]
+        })
+        .collect();
     let mut p: Vec<f64> = t.iter().map(|&u| g(u)).collect();
     let d = opts.fd_step * h;
-    let mut m: Vec<f64> = t
-        .iter()
-        .map(|&u| (g(u + d) - g(u - d)) / (2.0 * d))
-        .collect();
+    let mut m: Vec<f64> = match (opts.slopes, stress) {
+        (SlopeSource::Stress, Some(st)) => {
+            let (sx, sy): (Vec<f64>, Vec<f64>) = (0..x.len())
+                .filter(|&i| x[i].is_finite() && psi[i].is_finite() && st[i].is_finite())
+                .map(|i| (x[i], st[i]))
+                .unzip();
+            let ms = Mls1D::new(&sx, &sy, opts.bandwidth_factor)?;
+            t.iter()
+                .map(|&u| {
+                    if opts.symmetric {
+                        0.5 * (ms.eval(u) - ms.eval(-u))
+                    } else {
+                        ms.eval(u)
+                    }
+                })
+                .collect()
+        }
+        _ => t
+            .iter()
+            .map(|&u| (g(u + d) - g(u - d)) / (2.0 * d))
+            .collect(),
+    };
     if p.iter().chain(&m).any(|v| !v.is_finite()) {
         return Err(FitError::BadOption(
             "the MLS curve overflowed (Ψ too large for symexp)".into(),
@@ -247,6 +310,7 @@ pub fn fit1d(x: &[f64], psi: &[f64], opts: &Fit1DOptions) -> Result<Fit1D, FitEr
         spline,
         offset,
         report,
+        curve,
     })
 }
 
@@ -348,6 +412,31 @@ mod tests {
             },
         ] {
             assert!(matches!(fit1d(&x, &y, &bad), Err(FitError::BadOption(_))));
+        }
+    }
+
+    #[test]
+    fn slopes_from_stresses() {
+        let f = |v: f64| v * v + 0.5 * v.powi(4);
+        let df = |v: f64| 2.0 * v + 2.0 * v.powi(3);
+        let (x, y) = samples(f, -1.0, 1.0, 41);
+        let st: Vec<f64> = x.iter().map(|&v| df(v)).collect();
+        let o = Fit1DOptions {
+            slopes: SlopeSource::Stress,
+            ..Fit1DOptions::default()
+        };
+        assert!(fit1d(&x, &y, &o).is_err(), "stress slopes need stresses");
+        let fit = fit1d_with_stress(&x, &y, Some(&st), &o).unwrap();
+        let s = &fit.spline;
+        // interior knots keep the sampled derivative (the Fritsch–Carlson caps are not active on this convex data)
+        for i in 1..s.t.len() - 1 {
+            assert!(
+                (s.m[i] - df(s.t[i])).abs() < 2e-3,
+                "knot {}: {} vs {}",
+                s.t[i],
+                s.m[i],
+                df(s.t[i])
+            );
         }
     }
 

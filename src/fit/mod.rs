@@ -1,13 +1,21 @@
 //! Fitting the spline material from samples (C5–C7, `../shared/design/04-sampling-fitting.md`, section
-//! "Fitting (C5, C6, C7)"). So far the 1D part: the symlog transform ([`symlog`]), moving least squares ([`mls`])
-//! and FIT1D ([`fit1d`]), which works on any (X, Ψ) samples, synthetic ones included.
+//! "Fitting (C5, C6, C7)"): the symlog transform ([`symlog`]), moving least squares in 1D and 2D ([`mls`]),
+//! FIT1D ([`fit1d`]) and FIT2D ([`fit2d`]), which work on any samples, synthetic ones included, and FITSPLINES
+//! ([`model`]), which fits a whole material to the samples of a plan.
 
 pub mod fit1d;
+pub mod fit2d;
 pub mod mls;
+pub mod model;
+pub mod plot;
 pub mod symlog;
 
-pub use fit1d::{fit1d, Fit1D, Fit1DOptions, Fit1DReport, MinimumAt};
-pub use mls::Mls1D;
+pub use fit1d::{
+    fit1d, fit1d_with_stress, Fit1D, Fit1DOptions, Fit1DReport, MinimumAt, SlopeSource,
+};
+pub use fit2d::{fit2d, Fit2D, Fit2DOptions, Fit2DReport};
+pub use mls::{Mls1D, Mls2D};
+pub use model::{fit_material, holdout_error, FitOptions, FitReport, MaterialFit, ModelError};
 
 use std::fmt;
 

@@ -135,6 +135,18 @@ impl Pattern {
         yarns
     }
 
+    /// Total rest yarn length Σ l̄ of the tile (m).
+    pub fn total_rest_length(&self) -> f64 {
+        self.edges.iter().map(|e| e.rest_length).sum()
+    }
+
+    /// Areal mass density ρ_A = ρ π r² (total rest yarn length) / (p₁ p₂) (kg/m²) for yarn density `rho` (kg/m³)
+    /// (`04-sampling-fitting.md`, "Material JSON").
+    pub fn areal_density(&self, rho: f64) -> f64 {
+        rho * std::f64::consts::PI * self.radius * self.radius * self.total_rest_length()
+            / (self.periods[0] * self.periods[1])
+    }
+
     /// Voronoi rest length l̄ᵢ = (l̄ of the incoming edge + l̄ of the outgoing edge) / 2 of every vertex.
     pub fn voronoi_lengths(&self) -> Vec<f64> {
         let prev = self.prev();

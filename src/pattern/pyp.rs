@@ -689,6 +689,23 @@ impl Pattern {
         Ok((pattern, warnings))
     }
 
+    /// [`load_pyp`](Self::load_pyp), then, when the file's periods disagree with its periodic edges' rest lengths
+    /// (a [`PatternWarning`]), the implied periods instead (the original basket needs this). Returns the stored
+    /// periods that were replaced, if any.
+    pub fn load_pyp_at_implied_periods(
+        path: impl AsRef<Path>,
+    ) -> Result<(Pattern, Option<[f64; 2]>), PatternError> {
+        let (mut p, warnings) = Self::load_pyp(path)?;
+        let mut replaced = None;
+        if !warnings.is_empty() {
+            if let Some(implied) = p.implied_periods() {
+                replaced = Some(p.periods);
+                p.periods = implied;
+            }
+        }
+        Ok((p, replaced))
+    }
+
     /// Read a `.pyp` file (see [`Pattern::from_pyp_str`]); messages name the path as given.
     pub fn load_pyp(
         path: impl AsRef<Path>,

@@ -5,5 +5,5 @@
 pub mod plan;
 pub mod run;
 
-pub use plan::{sample_range, Chain, Plan, PlanError, Sample, Step};
+pub use plan::{sample_range, Chain, InPlaneGrid, Plan, PlanError, Sample, Step};
 pub use run::{merge, parse_shard, read_samples, run_plan, Record, RunOptions, RunSummary};

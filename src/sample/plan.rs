@@ -90,6 +90,46 @@ pub struct Plan {
     pub count_2d: usize,
     /// The strain pairs of the 2D grids, by name (`s_x`, `s_a`, `s_y`, `II00`, `II11`).
     pub pairs: Vec<[String; 2]>,
+    /// An optional tensor grid of in-plane strains (s_x, s_a, s_y all varying, no bending): held-out samples
+    /// off the sampled planes, which the additive model must predict (`04-sampling-fitting.md`, "Quality
+    /// report"). Absent from the JSON (and from the hash) when `None`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub grid: Option<InPlaneGrid>,
+}
+
+/// The explicit axis values of an in-plane tensor grid (samples (s_x, s_a, s_y, 0, 0), s_x index outermost).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InPlaneGrid {
+    pub s_x: Vec<f64>,
+    pub s_a: Vec<f64>,
+    pub s_y: Vec<f64>,
+}
+
+impl InPlaneGrid {
+    /// The 9×9×9 grid of the original displacement data (`06-verification.md`, item 3c): s_x, s_y ∈ {−0.2, −0.1,
+    /// 0, 1/6, …, 1}, s_a ∈ {−0.7, −0.525, …, 0.7}.
+    pub fn original() -> Self {
+        let stretch: Vec<f64> = [-0.2, -0.1]
+            .into_iter()
+            .chain((0..7).map(|i| i as f64 / 6.0))
+            .collect();
+        InPlaneGrid {
+            s_x: stretch.clone(),
+            s_a: (0..9).map(|i| 0.175 * (i as f64 - 4.0)).collect(),
+            s_y: stretch,
+        }
+    }
+
+    /// Number of grid points.
+    pub fn len(&self) -> usize {
+        self.s_x.len() * self.s_a.len() * self.s_y.len()
+    }
+
+    /// Whether the grid has no points.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
 }
 
 /// The design's nine pairs: {s_x,s_a,s_y}² unordered distinct, then {s_x,s_a,s_y}×{Π₀₀,Π₁₁}.
@@ -116,6 +156,7 @@ impl Default for Plan {
             count_1d: 150,
             count_2d: 50,
             pairs: default_pairs(),
+            grid: None,
         }
     }
 }
@@ -216,6 +257,23 @@ impl Plan {
         }
     }
 
+    /// The held-out plan: only the in-plane grid of [`InPlaneGrid::original`] (729 samples, no 1D ranges or
+    /// 2D grids).
+    pub fn holdout() -> Self {
+        Plan {
+            count_1d: 0,
+            count_2d: 0,
+            pairs: vec![],
+            grid: Some(InPlaneGrid::original()),
+            ..Plan::default()
+        }
+    }
+
+    /// Index of the first in-plane grid sample (after the 1D ranges and the 2D grids).
+    pub fn grid_start(&self) -> usize {
+        5 * self.count_1d + self.pairs.len() * self.count_2d * self.count_2d
+    }
+
     /// Check ranges, counts and pairs.
     pub fn validate(&self) -> Result<(), PlanError> {
         let err = |field: String, message: String| PlanError {
@@ -242,6 +300,23 @@ impl Plan {
                     format!("ranges.{name}"),
                     format!("[{lo}, {hi}] must contain 0 (SAMPLERANGE mirrors √|z| about 0)"),
                 ));
+            }
+        }
+        if let Some(g) = &self.grid {
+            for (name, values) in [("s_x", &g.s_x), ("s_a", &g.s_a), ("s_y", &g.s_y)] {
+                if values.is_empty() {
+                    return Err(err(format!("grid.{name}"), "empty".into()));
+                }
+                if let Some(v) = values.iter().find(|v| {
+                    !v.is_finite()
+                        || (name == "s_a" && v.abs() >= 1.0)
+                        || (name != "s_a" && **v <= -1.0)
+                }) {
+                    return Err(err(
+                        format!("grid.{name}"),
+                        format!("{v} is not an admissible value (stretches > −1, |s_a| < 1)"),
+                    ));
+                }
             }
         }
         for (i, [a, b]) in self.pairs.iter().enumerate() {
@@ -293,7 +368,7 @@ impl Plan {
         let obj = value
             .as_object()
             .ok_or_else(|| err("-", "a plan is a JSON object".into()))?;
-        const FIELDS: [&str; 4] = ["ranges", "count_1d", "count_2d", "pairs"];
+        const FIELDS: [&str; 5] = ["ranges", "count_1d", "count_2d", "pairs", "grid"];
         for key in obj.keys() {
             if !FIELDS.contains(&key.as_str()) {
                 return Err(err(
@@ -337,6 +412,10 @@ impl Plan {
             count_1d: field(obj, "count_1d").map_err(|m| err("count_1d", m))?,
             count_2d: field(obj, "count_2d").map_err(|m| err("count_2d", m))?,
             pairs: field(obj, "pairs").map_err(|m| err("pairs", m))?,
+            grid: match obj.get("grid") {
+                None | Some(serde_json::Value::Null) => None,
+                Some(_) => Some(field(obj, "grid").map_err(|m| err("grid", m))?),
+            },
         };
         plan.validate().map_err(|mut e| {
             e.file = file.map(str::to_string);
@@ -378,9 +457,9 @@ impl Plan {
         sample_range(k, lo, hi, self.count_2d)
     }
 
-    /// Number of samples: 5 · count_1d + pairs · count_2d².
+    /// Number of samples: 5 · count_1d + pairs · count_2d² + the in-plane grid's points.
     pub fn len(&self) -> usize {
-        5 * self.count_1d + self.pairs.len() * self.count_2d * self.count_2d
+        self.grid_start() + self.grid.as_ref().map_or(0, InPlaneGrid::len)
     }
 
     /// Whether the plan has no samples.
@@ -416,6 +495,15 @@ impl Plan {
                     z[a] = *x;
                     z[b] = *y;
                     zs.push(z);
+                }
+            }
+        }
+        if let Some(g) = &self.grid {
+            for &a in &g.s_x {
+                for &b in &g.s_a {
+                    for &c in &g.s_y {
+                        zs.push([a, b, c, 0.0, 0.0]);
+                    }
                 }
             }
         }
@@ -481,6 +569,38 @@ impl Plan {
             }
             chains.push(Chain { steps });
         }
+        // the in-plane grid: one chain per s_x value, cold at (s_x, s_a ≈ 0, s_y ≈ 0), then the s_a line as two
+        // rays, then every s_y line as two rays from it
+        if let Some(g) = &self.grid {
+            let base = self.grid_start();
+            let (na, ny) = (g.s_a.len(), g.s_y.len());
+            let (a0, aup, adown) = rays(&g.s_a);
+            let (y0, yup, ydown) = rays(&g.s_y);
+            for i in 0..g.s_x.len() {
+                let at = |a: usize, y: usize| base + (i * na + a) * ny + y;
+                let mut steps = vec![Step {
+                    sample: at(a0, y0),
+                    from: None,
+                }];
+                let mut line_step = vec![0usize; na];
+                for ray in [&aup, &adown] {
+                    let mut from = 0;
+                    for &a in ray {
+                        steps.push(Step {
+                            sample: at(a, y0),
+                            from: Some(from),
+                        });
+                        from = steps.len() - 1;
+                        line_step[a] = from;
+                    }
+                }
+                for a in 0..na {
+                    push_ray(&mut steps, line_step[a], yup.iter().map(|&y| at(a, y)));
+                    push_ray(&mut steps, line_step[a], ydown.iter().map(|&y| at(a, y)));
+                }
+                chains.push(Chain { steps });
+            }
+        }
         chains
     }
 }
@@ -488,6 +608,35 @@ impl Plan {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn holdout_grid_samples_and_chains() {
+        let p = Plan::holdout();
+        assert_eq!(p.len(), 729);
+        let s = p.samples();
+        assert_eq!(s[0].z, [-0.2, -0.7, -0.2, 0.0, 0.0]);
+        assert_eq!(s[728].z, [1.0, 0.7, 1.0, 0.0, 0.0]);
+        let chains = p.chains();
+        assert_eq!(chains.len(), 9);
+        let mut seen = vec![0; 729];
+        for c in &chains {
+            assert!(c.steps[0].from.is_none());
+            assert_eq!(s[c.steps[0].sample].z[1], 0.0);
+            for (k, st) in c.steps.iter().enumerate() {
+                seen[st.sample] += 1;
+                if k > 0 {
+                    assert!(st.from.unwrap() < k);
+                }
+            }
+        }
+        assert!(seen.iter().all(|&n| n == 1));
+        // round trip, and plans without a grid keep their JSON (and hash)
+        assert_eq!(Plan::from_json(&p.canonical_json(), None).unwrap(), p);
+        assert!(!Plan::default().canonical_json().contains("grid"));
+        let mut bad = p.clone();
+        bad.grid.as_mut().unwrap().s_a[0] = 1.0;
+        assert!(bad.validate().unwrap_err().field == "grid.s_a");
+    }
 
     #[test]
     fn counts() {

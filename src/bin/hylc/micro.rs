@@ -17,15 +17,13 @@ use std::path::Path;
 pub fn load_pattern(arg: &str) -> Result<Pattern, String> {
     let path = Path::new(arg);
     if path.extension().is_some_and(|e| e == "pyp") || path.exists() {
-        let (mut p, warnings) = Pattern::load_pyp(path).map_err(|e| e.to_string())?;
-        if !warnings.is_empty() {
-            if let Some(implied) = p.implied_periods() {
-                eprintln!(
-                    "note: {arg}: periods {:?} disagree with the rest lengths; using the implied periods {:?}",
-                    p.periods, implied
-                );
-                p.periods = implied;
-            }
+        let (p, replaced) =
+            Pattern::load_pyp_at_implied_periods(path).map_err(|e| e.to_string())?;
+        if let Some(stored) = replaced {
+            eprintln!(
+                "note: {arg}: periods {stored:?} disagree with the rest lengths; using the implied periods {:?}",
+                p.periods
+            );
         }
         Ok(p)
     } else {

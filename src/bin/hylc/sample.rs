@@ -4,6 +4,7 @@
 use crate::micro::load_pattern;
 use hylc::micro::{MicroProblem, SolverOptions};
 use hylc::rod::YarnMaterial;
+use hylc::sample::run::problem_hash;
 use hylc::sample::{merge, parse_shard, run_plan, Plan, RunOptions};
 use std::path::{Path, PathBuf};
 
@@ -12,8 +13,39 @@ pub fn load_plan(arg: &str) -> Result<Plan, String> {
     match arg {
         "default" => Ok(Plan::default()),
         "reduced" => Ok(Plan::reduced()),
+        "holdout" => Ok(Plan::holdout()),
         _ => Plan::load(Path::new(arg)).map_err(|e| e.to_string()),
     }
+}
+
+/// The sidecar of a sample file: `samples.jsonl` → `samples.meta.json`.
+pub fn meta_path(samples: &Path) -> PathBuf {
+    samples.with_extension("meta.json")
+}
+
+/// Write the sidecar of a sample file: the plan, the pattern (its `.pyp` text), the yarn parameters, the solver
+/// settings, the problem hash and the pattern's areal density, which `hylc fit` reads.
+fn write_meta(out: &Path, arg: &str, plan: &Plan, problem: &MicroProblem) -> Result<(), String> {
+    let m = &problem.material;
+    let pyp = problem.pattern.to_pyp_string();
+    let meta = serde_json::json!({
+        "pattern": arg,
+        "pyp hash": format!("{:016x}", hylc::sample::plan::fnv1a64(pyp.as_bytes())),
+        "problem": problem_hash(problem),
+        "plan": plan,
+        "density": problem.pattern.areal_density(m.density),
+        "yarn": {
+            "young": m.young, "shear": m.shear, "bend_twist_factor": m.bend_twist_factor, "radius": m.radius,
+            "density": m.density, "contact_stiffness": m.contact_stiffness,
+            "contact_quadrature": m.contact_quadrature, "contact_exclusion": m.contact_exclusion,
+        },
+        "solver": problem.options,
+        "periods": problem.pattern.periods,
+        "pyp": pyp,
+    });
+    let path = meta_path(out);
+    let text = serde_json::to_string_pretty(&meta).map_err(|e| e.to_string())?;
+    std::fs::write(&path, text + "\n").map_err(|e| format!("{}: cannot write: {e}", path.display()))
 }
 
 /// `hylc sample`: run a plan on a pattern; true when every written sample converged.
@@ -30,6 +62,7 @@ pub fn sample(
     let shard = shard.map(parse_shard).transpose()?;
     let p = load_pattern(pattern)?;
     let problem = MicroProblem::new(p, &YarnMaterial::default(), options);
+    write_meta(out, pattern, &plan, &problem)?;
     let s = run_plan(
         &problem,
         &plan,
@@ -65,6 +98,11 @@ pub fn merge_cmd(out: &Path, inputs: &[PathBuf]) -> Result<(), String> {
     }
     let ins: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
     let (n, dup) = merge(out, &ins)?;
+    // the first input's sidecar goes with the merged file (shards of one plan and problem share it)
+    if let Some(src) = inputs.iter().map(|p| meta_path(p)).find(|p| p.exists()) {
+        std::fs::copy(&src, meta_path(out))
+            .map_err(|e| format!("{}: cannot copy the sidecar: {e}", src.display()))?;
+    }
     println!(
         "{}: {n} samples from {} files ({dup} duplicates dropped)",
         out.display(),
@@ -73,12 +111,13 @@ pub fn merge_cmd(out: &Path, inputs: &[PathBuf]) -> Result<(), String> {
     Ok(())
 }
 
-/// `hylc plan --write FILE [--reduced]`.
-pub fn plan_cmd(write: &Path, reduced: bool) -> Result<(), String> {
-    let plan = if reduced {
-        Plan::reduced()
-    } else {
-        Plan::default()
+/// `hylc plan --write FILE [--reduced | --holdout]`.
+pub fn plan_cmd(write: &Path, reduced: bool, holdout: bool) -> Result<(), String> {
+    let plan = match (reduced, holdout) {
+        (true, true) => return Err("plan: --reduced and --holdout exclude each other".into()),
+        (true, false) => Plan::reduced(),
+        (false, true) => Plan::holdout(),
+        (false, false) => Plan::default(),
     };
     let text = serde_json::to_string_pretty(&plan).map_err(|e| e.to_string())?;
     std::fs::write(write, text + "\n").map_err(|e| format!("{}: {e}", write.display()))?;

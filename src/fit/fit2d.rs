@@ -1,0 +1,639 @@
+//! FIT2D (`04-sampling-fitting.md`, "Fitting (C5, C6, C7)", FIT2D steps 1–7): one 2D term f_kl of the material
+//! from samples (X, Y, Ψ) of its 2D grid (X, Y already normalised by the strain scales).
+//!
+//! 1. g(u, v) = symexp(MLS(u, v | X, Y, symlog Ψ)) with a 2D local-quadratic MLS ([`Mls2D`]), symmetrised in the
+//!    axis that is s_a.
+//! 2. Knots per axis: linspace on [e·min, 0] and on [0, e·max] sharing 0 (e = `extent`, 0.9; 0.3 for
+//!    stockinette-like patterns). The axis's `n_knots − 1` intervals are split between the two sides in proportion
+//!    to their lengths, at least one per non-empty side (this reproduces the knot layout of the original
+//!    materials, e.g. 1 + 6 intervals for s_x on [−0.1, 0.84]). p = g at the knots; pˣ, pʸ, pˣʸ by central
+//!    differences of g (step `fd_step` × the smallest knot spacing of the axis).
+//! 3. Quasi-convexification (not for (s_x, s_y)): i_min = the knot u = 0; j_min = the knot v = 0 for an in-plane
+//!    second strain, else argmin_j p(0, v_j). Rows are processed outward from j_min and each row outward from
+//!    i_min, raising every value to p ≥ (its inner neighbour along the row) + Δu pˣ_min and ≥ (its inner
+//!    neighbour along the column) + Δv pˣ_min; both inner neighbours are final when a value is visited, so both
+//!    conditions hold at the end. Slopes: pˣ ≥ pˣ_min right of i_min (≤ −pˣ_min left of it), pʸ likewise about
+//!    j_min.
+//! 4. Increasing extrapolation: boundary pˣ (first/last column) clamped to ≤ −pˣ_min / ≥ pˣ_min, boundary pʸ
+//!    likewise, pˣʸ = 0 on the boundary.
+//! 5. Monotone bicubic correction: Fritsch–Carlson along every row (pˣ) and column (pʸ): a slope is capped at
+//!    3 |secant| of each adjacent cell it agrees with, and set to 0 where it disagrees in sign (the minimum knot
+//!    exempt, as in FIT1D); along grid lines the bicubic is exactly these 1D Hermite cubics, so it is monotone
+//!    along every grid line outward from the minimum. Inside the patches monotonicity also depends on the twists
+//!    pˣʸ. Carlson & Fritsch (1985) give sufficient conditions; not having them, we check the sign of ∂f/∂u
+//!    (∂f/∂v) on a 7 × 7 grid of every patch not touching the minimum's column (row) and halve the four corner
+//!    twists of each failing patch, up to 40 rounds, then zero them. Patches that still fail (a twist-free patch
+//!    can be non-monotone when pʸ varies strongly along u) are counted in the report, not hidden.
+//! 6. Residual: r(u, v) = f(u, v) − f(u, 0) − f(0, v) + f(0, 0), i.e. on the knots p − p(·, 0) − p(0, ·) + p(0, 0),
+//!    pˣ − pˣ(·, 0), pʸ − pʸ(0, ·) and pˣʸ unchanged. This is exact as a function (f(u, 0) and f(0, v) are
+//!    bicubics themselves), so r vanishes identically on both axes, extrapolation included.
+//! 7. Zero-compression residual (not for (s_x, s_y)): on a stretch axis (s_x or s_y), every knot with that
+//!    coordinate ≤ 0 gets p = pˣ = pʸ = pˣʸ = 0. Including the knot at 0 (where p and the along-axis slope are
+//!    already 0) makes r vanish on the whole compressed half-plane, not only at its knots; the original keeps a
+//!    non-zero twist there.
+//!
+//! The unconverted spline f of step 5 is returned too ([`Fit2D::full`]): its errors against the samples are the
+//! fit's own quality; the material uses the residual.
+
+use super::fit1d::MinimumAt;
+use super::mls::{Mls2D, DEFAULT_BANDWIDTH_FACTOR};
+use super::symlog::{symexp, symlog};
+use super::FitError;
+use crate::material::Hermite2D;
+
+/// FIT2D parameters; [`Default`] gives the design's defaults for a pair of in-plane strains other than s_a.
+#[derive(Clone, Debug)]
+pub struct Fit2DOptions {
+    /// knots per axis (u, v) including 0 (default 9 each; the original uses 8–10)
+    pub n_knots: [usize; 2],
+    /// e: knots span [e·min, e·max] of the data (default 0.9; 0.3 for stockinette-like patterns)
+    pub extent: f64,
+    /// MLS bandwidth in median sample spacings (default 2)
+    pub bandwidth_factor: f64,
+    /// ε = eps_rel · max|Ψ| in symlog (default 1e-3)
+    pub eps_rel: f64,
+    /// pˣ_min (default 0.001; 0.01 for stockinette-like patterns), > 0
+    pub min_slope: f64,
+    /// symmetrise the MLS in u and/or v (the axis that is s_a)
+    pub symmetric: [bool; 2],
+    /// steps 3 and 7 (false for (s_x, s_y))
+    pub quasi_convex: bool,
+    /// j_min rule: the knot v = 0 (in-plane second strain) or argmin along u = 0 (bending)
+    pub minimum_v: MinimumAt,
+    /// axes that are stretches (s_x, s_y): their compressed side is zeroed in step 7
+    pub stretch: [bool; 2],
+    /// central-difference step as a fraction of the smallest knot spacing (default 1e-3)
+    pub fd_step: f64,
+}
+
+impl Default for Fit2DOptions {
+    fn default() -> Self {
+        Fit2DOptions {
+            n_knots: [9, 9],
+            extent: 0.9,
+            bandwidth_factor: DEFAULT_BANDWIDTH_FACTOR,
+            eps_rel: 1e-3,
+            min_slope: 1e-3,
+            symmetric: [false, false],
+            quasi_convex: true,
+            minimum_v: MinimumAt::Zero,
+            stretch: [false, false],
+            fd_step: 1e-3,
+        }
+    }
+}
+
+/// Fit quality of the unconverted spline f at the samples it was fitted to.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fit2DReport {
+    pub n_samples: usize,
+    /// samples excluded because a coordinate or Ψ is not finite (failed solves)
+    pub n_excluded: usize,
+    /// √(Σ e²) / √(Σ Ψ²), e = f − Ψ
+    pub rms_rel: f64,
+    /// max |e| / max |Ψ|
+    pub max_rel: f64,
+    /// minimum knot (i_min along u, j_min along v)
+    pub i_min: usize,
+    pub j_min: usize,
+    /// rounds of twist halving that step 5 needed
+    pub twist_rounds: usize,
+    /// patches still failing the monotonicity check of step 5
+    pub nonmonotone_patches: usize,
+}
+
+/// A fitted 2D term: the residual spline the material uses, the unconverted spline f, and the report.
+#[derive(Clone, Debug)]
+pub struct Fit2D {
+    pub residual: Hermite2D,
+    pub full: Hermite2D,
+    pub report: Fit2DReport,
+}
+
+/// Knots of one axis (step 2) for data spanning [lo, hi].
+pub fn axis_knots(lo: f64, hi: f64, n: usize, extent: f64) -> Result<Vec<f64>, FitError> {
+    let (a, b) = (extent * lo.min(0.0), extent * hi.max(0.0));
+    let sides = usize::from(a < 0.0) + usize::from(b > 0.0);
+    if sides == 0 || n < sides + 1 {
+        return Err(FitError::Knots(format!(
+            "{n} knots cannot cover [{a}, 0] and [0, {b}] (data [{lo}, {hi}])"
+        )));
+    }
+    let intervals = n - 1;
+    let mut left = if a < 0.0 {
+        ((intervals as f64 * -a / (b - a)).round() as usize).max(1)
+    } else {
+        0
+    };
+    if b > 0.0 {
+        left = left.min(intervals - 1);
+    } else {
+        left = intervals;
+    }
+    let right = intervals - left;
+    let mut t: Vec<f64> = (0..left)
+        .map(|i| a * (left - i) as f64 / left as f64)
+        .collect();
+    t.push(0.0);
+    t.extend((1..=right).map(|i| b * i as f64 / right as f64));
+    Ok(t)
+}
+
+fn check_options(o: &Fit2DOptions) -> Result<(), FitError> {
+    let bad = |s: String| Err(FitError::BadOption(s));
+    if o.n_knots.iter().any(|&n| n < 3) {
+        return bad(format!("n_knots = {:?} (need ≥ 3 per axis)", o.n_knots));
+    }
+    if !(o.extent.is_finite() && o.extent > 0.0 && o.extent <= 1.0) {
+        return bad(format!("extent = {} (need in (0, 1])", o.extent));
+    }
+    if !(o.eps_rel.is_finite() && o.eps_rel > 0.0) {
+        return bad(format!("eps_rel = {} (need finite, > 0)", o.eps_rel));
+    }
+    if !(o.min_slope.is_finite() && o.min_slope > 0.0) {
+        return bad(format!("min_slope = {} (need finite, > 0)", o.min_slope));
+    }
+    if !(o.fd_step.is_finite() && o.fd_step > 0.0 && o.fd_step <= 0.5) {
+        return bad(format!("fd_step = {} (need in (0, 0.5])", o.fd_step));
+    }
+    Ok(())
+}
+
+/// Fritsch–Carlson limits along one grid line (step 5): `p`, `m` are the values and slopes at `t`; `min` is the
+/// minimum knot whose slope keeps its sign.
+fn limit_line(t: &[f64], p: &[f64], m: &mut [f64], min: Option<usize>) {
+    for c in 0..t.len() - 1 {
+        let secant = (p[c + 1] - p[c]) / (t[c + 1] - t[c]);
+        for i in [c, c + 1] {
+            if min == Some(i) {
+                if m[i] * secant > 0.0 && m[i].abs() > 3.0 * secant.abs() {
+                    m[i] = (3.0 * secant.abs()).copysign(m[i]);
+                }
+            } else if m[i] * secant <= 0.0 {
+                m[i] = 0.0;
+            } else if m[i].abs() > 3.0 * secant.abs() {
+                m[i] = (3.0 * secant.abs()).copysign(m[i]);
+            }
+        }
+    }
+}
+
+/// Grid data of a bicubic Hermite spline with u inner: index j·nu + i.
+struct Grid {
+    tu: Vec<f64>,
+    tv: Vec<f64>,
+    p: Vec<f64>,
+    mu: Vec<f64>,
+    mv: Vec<f64>,
+    muv: Vec<f64>,
+}
+
+impl Grid {
+    fn at(&self, i: usize, j: usize) -> usize {
+        j * self.tu.len() + i
+    }
+
+    fn spline(&self) -> Hermite2D {
+        Hermite2D::new(
+            self.tu.clone(),
+            self.tv.clone(),
+            self.p.clone(),
+            self.mu.clone(),
+            self.mv.clone(),
+            self.muv.clone(),
+        )
+    }
+
+    /// Patches failing the interior monotonicity check of step 5 (sign of ∂f/∂u and ∂f/∂v away from the minimum).
+    fn failing_patches(&self, i_min: usize, j_min: usize) -> Vec<(usize, usize)> {
+        let s = self.spline();
+        let scale = self
+            .p
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(1e-300);
+        let (nu, nv) = (self.tu.len(), self.tv.len());
+        let mut out = Vec::new();
+        for cj in 0..nv - 1 {
+            for ci in 0..nu - 1 {
+                let sx = if ci < i_min { -1.0 } else { 1.0 };
+                let sy = if cj < j_min { -1.0 } else { 1.0 };
+                let check_x = ci != i_min && ci + 1 != i_min;
+                let check_y = cj != j_min && cj + 1 != j_min;
+                if !(check_x || check_y) {
+                    continue;
+                }
+                let (hu, hv) = (self.tu[ci + 1] - self.tu[ci], self.tv[cj + 1] - self.tv[cj]);
+                let tol_u = 1e-10 * scale / hu;
+                let tol_v = 1e-10 * scale / hv;
+                let mut bad = false;
+                'pts: for a in 0..=6 {
+                    for b in 0..=6 {
+                        let u = self.tu[ci] + hu * a as f64 / 6.0;
+                        let v = self.tv[cj] + hv * b as f64 / 6.0;
+                        let d = s.eval2(u, v);
+                        if (check_x && sx * d[1] < -tol_u) || (check_y && sy * d[2] < -tol_v) {
+                            bad = true;
+                            break 'pts;
+                        }
+                    }
+                }
+                if bad {
+                    out.push((ci, cj));
+                }
+            }
+        }
+        out
+    }
+}
+
+/// FIT2D on samples `x`, `y` (normalised strains) and `psi`. Samples where any of the three is not finite are
+/// excluded and counted. Errors: length mismatch, too few usable samples, invalid options, or data that do not
+/// reach 0 on an axis.
+pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<Fit2D, FitError> {
+    if x.len() != psi.len() || y.len() != psi.len() {
+        return Err(FitError::LengthMismatch {
+            x: x.len().min(y.len()),
+            psi: psi.len(),
+        });
+    }
+    check_options(opts)?;
+    let mut xs = Vec::new();
+    let mut ys = Vec::new();
+    let mut fs = Vec::new();
+    for i in 0..psi.len() {
+        if x[i].is_finite() && y[i].is_finite() && psi[i].is_finite() {
+            xs.push(x[i]);
+            ys.push(y[i]);
+            fs.push(psi[i]);
+        }
+    }
+    let n_excluded = psi.len() - fs.len();
+
+    // step 1
+    let psi_max = fs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let eps = if psi_max > 0.0 {
+        opts.eps_rel * psi_max
+    } else {
+        1.0
+    };
+    let logs: Vec<f64> = fs.iter().map(|&v| symlog(v, eps)).collect();
+    let mls = Mls2D::new(&xs, &ys, &logs, opts.bandwidth_factor)?;
+    let [su, sv] = opts.symmetric;
+    let g = |u: f64, v: f64| symexp(mls.eval_symmetric(u, v, su, sv), eps);
+
+    // step 2
+    let range = |d: &[f64]| {
+        d.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                (l.min(v), h.max(v))
+            })
+    };
+    let (xl, xh) = range(&xs);
+    let (yl, yh) = range(&ys);
+    let tu = axis_knots(xl, xh, opts.n_knots[0], opts.extent)?;
+    let tv = axis_knots(yl, yh, opts.n_knots[1], opts.extent)?;
+    let (nu, nv) = (tu.len(), tv.len());
+    let min_gap = |t: &[f64]| {
+        t.windows(2)
+            .map(|w| w[1] - w[0])
+            .fold(f64::INFINITY, f64::min)
+    };
+    let du = opts.fd_step * min_gap(&tu);
+    let dv = opts.fd_step * min_gap(&tv);
+    let mut grid = Grid {
+        p: vec![0.0; nu * nv],
+        mu: vec![0.0; nu * nv],
+        mv: vec![0.0; nu * nv],
+        muv: vec![0.0; nu * nv],
+        tu,
+        tv,
+    };
+    for j in 0..nv {
+        for i in 0..nu {
+            let (u, v) = (grid.tu[i], grid.tv[j]);
+            let k = grid.at(i, j);
+            grid.p[k] = g(u, v);
+            grid.mu[k] = (g(u + du, v) - g(u - du, v)) / (2.0 * du);
+            grid.mv[k] = (g(u, v + dv) - g(u, v - dv)) / (2.0 * dv);
+            grid.muv[k] = (g(u + du, v + dv) - g(u + du, v - dv) - g(u - du, v + dv)
+                + g(u - du, v - dv))
+                / (4.0 * du * dv);
+        }
+    }
+    if [&grid.p, &grid.mu, &grid.mv, &grid.muv]
+        .iter()
+        .any(|a| a.iter().any(|v| !v.is_finite()))
+    {
+        return Err(FitError::BadOption(
+            "the MLS surface is not finite at the knots (Ψ too large for symexp, or too few samples near a knot)"
+                .into(),
+        ));
+    }
+
+    // step 3
+    let i_min = grid.tu.iter().position(|&t| t == 0.0).unwrap_or(0);
+    let j0 = grid.tv.iter().position(|&t| t == 0.0).unwrap_or(0);
+    let j_min = match opts.minimum_v {
+        MinimumAt::Zero => j0,
+        MinimumAt::Argmin => (0..nv).fold(0, |b, j| {
+            if grid.p[grid.at(i_min, j)] < grid.p[grid.at(i_min, b)] {
+                j
+            } else {
+                b
+            }
+        }),
+    };
+    let pmin = opts.min_slope;
+    let outward = |n: usize, c: usize| -> Vec<usize> {
+        let mut o = vec![c];
+        o.extend(c + 1..n);
+        o.extend((0..c).rev());
+        o
+    };
+    if opts.quasi_convex {
+        for &j in &outward(nv, j_min) {
+            for &i in &outward(nu, i_min) {
+                let k = grid.at(i, j);
+                let mut v = grid.p[k];
+                if i != i_min {
+                    let ii = if i > i_min { i - 1 } else { i + 1 };
+                    v = v.max(grid.p[grid.at(ii, j)] + (grid.tu[i] - grid.tu[ii]).abs() * pmin);
+                    grid.mu[k] = if i > i_min {
+                        grid.mu[k].max(pmin)
+                    } else {
+                        grid.mu[k].min(-pmin)
+                    };
+                }
+                if j != j_min {
+                    let jj = if j > j_min { j - 1 } else { j + 1 };
+                    v = v.max(grid.p[grid.at(i, jj)] + (grid.tv[j] - grid.tv[jj]).abs() * pmin);
+                    grid.mv[k] = if j > j_min {
+                        grid.mv[k].max(pmin)
+                    } else {
+                        grid.mv[k].min(-pmin)
+                    };
+                }
+                grid.p[k] = v;
+            }
+        }
+    }
+
+    // step 4 (applied again after step 5 so the Fritsch–Carlson zeroing of (s_x, s_y) cannot undo it)
+    let clamp_boundary = |grid: &mut Grid| {
+        for j in 0..nv {
+            let (a, b) = (grid.at(0, j), grid.at(nu - 1, j));
+            grid.mu[a] = grid.mu[a].min(-pmin);
+            grid.mu[b] = grid.mu[b].max(pmin);
+        }
+        for i in 0..nu {
+            let (a, b) = (grid.at(i, 0), grid.at(i, nv - 1));
+            grid.mv[a] = grid.mv[a].min(-pmin);
+            grid.mv[b] = grid.mv[b].max(pmin);
+        }
+        for j in 0..nv {
+            for i in 0..nu {
+                if i == 0 || j == 0 || i == nu - 1 || j == nv - 1 {
+                    let k = grid.at(i, j);
+                    grid.muv[k] = 0.0;
+                }
+            }
+        }
+    };
+    clamp_boundary(&mut grid);
+
+    // step 5: Fritsch–Carlson along rows and columns
+    let (mi, mj) = if opts.quasi_convex {
+        (Some(i_min), Some(j_min))
+    } else {
+        (None, None)
+    };
+    for j in 0..nv {
+        let ks: Vec<usize> = (0..nu).map(|i| grid.at(i, j)).collect();
+        let p: Vec<f64> = ks.iter().map(|&k| grid.p[k]).collect();
+        let mut m: Vec<f64> = ks.iter().map(|&k| grid.mu[k]).collect();
+        limit_line(&grid.tu, &p, &mut m, mi);
+        for (&k, v) in ks.iter().zip(m) {
+            grid.mu[k] = v;
+        }
+    }
+    for i in 0..nu {
+        let ks: Vec<usize> = (0..nv).map(|j| grid.at(i, j)).collect();
+        let p: Vec<f64> = ks.iter().map(|&k| grid.p[k]).collect();
+        let mut m: Vec<f64> = ks.iter().map(|&k| grid.mv[k]).collect();
+        limit_line(&grid.tv, &p, &mut m, mj);
+        for (&k, v) in ks.iter().zip(m) {
+            grid.mv[k] = v;
+        }
+    }
+    clamp_boundary(&mut grid);
+    // twists: halve at the corners of failing patches, then zero
+    let mut twist_rounds = 0;
+    let mut nonmonotone_patches = 0;
+    if opts.quasi_convex {
+        let corners = |grid: &Grid, (ci, cj): (usize, usize)| {
+            [
+                grid.at(ci, cj),
+                grid.at(ci + 1, cj),
+                grid.at(ci, cj + 1),
+                grid.at(ci + 1, cj + 1),
+            ]
+        };
+        let mut failing = grid.failing_patches(i_min, j_min);
+        while !failing.is_empty() && twist_rounds < 40 {
+            twist_rounds += 1;
+            let mut seen = std::collections::HashSet::new();
+            for &pc in &failing {
+                for k in corners(&grid, pc) {
+                    if seen.insert(k) {
+                        grid.muv[k] *= 0.5;
+                    }
+                }
+            }
+            failing = grid.failing_patches(i_min, j_min);
+        }
+        if !failing.is_empty() {
+            for &pc in &failing {
+                for k in corners(&grid, pc) {
+                    grid.muv[k] = 0.0;
+                }
+            }
+            nonmonotone_patches = grid.failing_patches(i_min, j_min).len();
+        }
+    }
+    let full = grid.spline();
+
+    // report on the unconverted spline
+    let (mut se, mut sp, mut emax) = (0.0f64, 0.0f64, 0.0f64);
+    for ((&u, &v), &f) in xs.iter().zip(&ys).zip(&fs) {
+        let e = full.eval2(u, v)[0] - f;
+        se += e * e;
+        sp += f * f;
+        emax = emax.max(e.abs());
+    }
+
+    // step 6: residual about the knots u = 0 (i0 = i_min) and v = 0 (j0)
+    let i0 = i_min;
+    let mut r = Grid {
+        tu: grid.tu.clone(),
+        tv: grid.tv.clone(),
+        p: vec![0.0; nu * nv],
+        mu: vec![0.0; nu * nv],
+        mv: vec![0.0; nu * nv],
+        muv: grid.muv.clone(),
+    };
+    for j in 0..nv {
+        for i in 0..nu {
+            let k = grid.at(i, j);
+            let (kx, ky, k00) = (grid.at(i, j0), grid.at(i0, j), grid.at(i0, j0));
+            r.p[k] = grid.p[k] - grid.p[kx] - grid.p[ky] + grid.p[k00];
+            r.mu[k] = grid.mu[k] - grid.mu[kx];
+            r.mv[k] = grid.mv[k] - grid.mv[ky];
+        }
+    }
+    // exact zeros on the axes (the formulas above give them up to rounding only when p(0,0) ≠ 0)
+    for i in 0..nu {
+        let k = r.at(i, j0);
+        r.p[k] = 0.0;
+        r.mu[k] = 0.0;
+    }
+    for j in 0..nv {
+        let k = r.at(i0, j);
+        r.p[k] = 0.0;
+        r.mv[k] = 0.0;
+    }
+
+    // step 7: zero-compression residual
+    if opts.quasi_convex {
+        for j in 0..nv {
+            for i in 0..nu {
+                if (opts.stretch[0] && r.tu[i] <= 0.0) || (opts.stretch[1] && r.tv[j] <= 0.0) {
+                    let k = r.at(i, j);
+                    r.p[k] = 0.0;
+                    r.mu[k] = 0.0;
+                    r.mv[k] = 0.0;
+                    r.muv[k] = 0.0;
+                }
+            }
+        }
+    }
+
+    let report = Fit2DReport {
+        n_samples: fs.len(),
+        n_excluded,
+        rms_rel: if sp > 0.0 {
+            (se / sp).sqrt()
+        } else {
+            se.sqrt()
+        },
+        max_rel: if psi_max > 0.0 { emax / psi_max } else { emax },
+        i_min,
+        j_min,
+        twist_rounds,
+        nonmonotone_patches,
+    };
+    Ok(Fit2D {
+        residual: r.spline(),
+        full,
+        report,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid_samples(
+        f: impl Fn(f64, f64) -> f64,
+        xr: [f64; 2],
+        yr: [f64; 2],
+        n: usize,
+    ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+        let (mut x, mut y, mut z) = (vec![], vec![], vec![]);
+        for i in 0..n {
+            for j in 0..n {
+                let u = xr[0] + (xr[1] - xr[0]) * i as f64 / (n - 1) as f64;
+                let v = yr[0] + (yr[1] - yr[0]) * j as f64 / (n - 1) as f64;
+                x.push(u);
+                y.push(v);
+                z.push(f(u, v));
+            }
+        }
+        (x, y, z)
+    }
+
+    #[test]
+    fn knots_reproduce_the_original_layout() {
+        // s_x on [−0.1, 0.84] with 8 knots: −0.09, 0, then 6 steps of 0.126 (basket1's (s_x, s_a) term)
+        let t = axis_knots(-0.1, 0.84, 8, 0.9).unwrap();
+        let want = [-0.09, 0.0, 0.126, 0.252, 0.378, 0.504, 0.63, 0.756];
+        assert_eq!(t.len(), want.len());
+        for (a, b) in t.iter().zip(want) {
+            assert!((a - b).abs() < 1e-12, "{t:?}");
+        }
+        // s_x on [−0.44, 1] with 10 knots: 3 + 6 intervals (basket1's (s_x, s_y) term)
+        let t = axis_knots(-0.44, 1.0, 10, 0.9).unwrap();
+        assert!((t[0] + 0.396).abs() < 1e-12 && (t[3]).abs() == 0.0 && (t[4] - 0.15).abs() < 1e-12);
+        assert!(axis_knots(0.0, 0.0, 9, 0.9).is_err());
+        assert!(axis_knots(-1.0, 1.0, 2, 0.9).is_err());
+    }
+
+    #[test]
+    fn residual_vanishes_on_axes_and_in_compression() {
+        let f = |u: f64, v: f64| 1.0 + u * u + 0.5 * v * v + 0.8 * u * u * v * v + 0.2 * u.powi(3);
+        let (x, y, z) = grid_samples(f, [-0.4, 1.0], [-1.0, 1.0], 30);
+        let o = Fit2DOptions {
+            stretch: [true, false],
+            ..Default::default()
+        };
+        let fit = fit2d(&x, &y, &z, &o).unwrap();
+        let r = &fit.residual;
+        for k in 0..=200 {
+            let s = -1.5 + 3.0 * k as f64 / 200.0;
+            assert_eq!(r.eval2(s, 0.0)[0], 0.0, "on v = 0 at u = {s}");
+            assert_eq!(r.eval2(0.0, s)[0], 0.0, "on u = 0 at v = {s}");
+            assert_eq!(
+                r.eval2(-0.05 * (1.0 + s.abs()), s)[0],
+                0.0,
+                "compressed at v = {s}"
+            );
+        }
+        // the coupling u²v² shows up where both are non-zero
+        assert!(r.eval2(0.8, 0.8)[0] > 0.1);
+        // the unconverted spline reproduces the smooth data (the largest errors are in the linear extrapolation
+        // between the last knot, at 0.9 of the range, and the data's end)
+        assert!(
+            fit.report.rms_rel < 5e-3 && fit.report.max_rel < 3e-2,
+            "{:?}",
+            fit.report
+        );
+        assert_eq!(fit.report.nonmonotone_patches, 0);
+    }
+
+    #[test]
+    fn bad_input_is_an_error() {
+        let (x, y, z) = grid_samples(|u, v| u * u + v * v, [-1.0, 1.0], [-1.0, 1.0], 10);
+        assert!(fit2d(&x[..5], &y, &z, &Fit2DOptions::default()).is_err());
+        for bad in [
+            Fit2DOptions {
+                n_knots: [2, 9],
+                ..Default::default()
+            },
+            Fit2DOptions {
+                extent: 0.0,
+                ..Default::default()
+            },
+            Fit2DOptions {
+                min_slope: 0.0,
+                ..Default::default()
+            },
+        ] {
+            assert!(matches!(
+                fit2d(&x, &y, &z, &bad),
+                Err(FitError::BadOption(_))
+            ));
+        }
+        let nan = vec![f64::NAN; z.len()];
+        assert!(fit2d(&x, &y, &nan, &Fit2DOptions::default()).is_err());
+    }
+}

@@ -1,0 +1,572 @@
+//! FITSPLINES (Algorithm C5; `04-sampling-fitting.md`, "Fitting (C5, C6, C7)"): the whole material
+//! ψ(z) = f₀ + Σ_k f_k(z_k/σ_k) + Σ_(k,l) f_kl(z_k/σ_k, z_l/σ_l) from the samples of one plan.
+//!
+//! - Strain scales σ_k = max |z_k| over the plan's samples (1 for a strain the plan never varies).
+//! - Failed samples (no Ψ̄) are excluded and counted per term.
+//! - f_k = FIT1D on the 1D range of strain k ([`fit1d`]): symmetrised for s_a, minimum at 0 for the in-plane
+//!   strains and at argmin p for bending.
+//! - f₀ = Ψ̄ of the converged s_a-range sample nearest z = 0 (any sample if none; for the default plan the s_a samples
+//!   at ±(√0.7/149)² ≈ ±3e-5, where Ψ̄ is even in s_a, so this is Ψ̄(0) to ~1e-9 relative). The 1D fits' own
+//!   values at 0 (the offsets FIT1D removes, the MLS estimates of Ψ̄(0)) are reported next to it: their
+//!   deviation from f₀ is a bias of the model along that range, largest on coarse plans.
+//! - f_kl = FIT2D on each pair's grid ([`fit2d`]), residual form; (s_x, s_y) is neither quasi-convexified nor
+//!   zero-compressed, a stretch axis of any other pair is zero-compressed, an s_a axis is symmetrised, and the
+//!   minimum of a bending axis is its argmin. The pair's strains are ordered k < l in the material.
+//! - Errors of the whole model ψ against every sample it was fitted to (1D ranges and 2D planes) and, optionally,
+//!   against held-out samples ([`holdout_error`], e.g. the in-plane grid of [`crate::sample::plan::InPlaneGrid`]).
+//!
+//! The exported material carries a `meta` block (pattern, yarn parameters, plan hash, fit errors) and the
+//! original's `"strain shift": [1, 0, 1, 0, 0]`, so the original macro-scale code reads it too.
+
+use super::fit1d::{fit1d_with_stress, Fit1D, Fit1DOptions, MinimumAt, SlopeSource};
+use super::fit2d::{fit2d, Fit2D, Fit2DOptions};
+use super::FitError;
+use crate::material::{Material, Term1D, Term2D};
+use crate::micro::strain::STRAIN_NAMES;
+use crate::sample::{Plan, Record};
+use serde::Serialize;
+
+/// Options of the whole fit; [`Default`] gives the design's defaults.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitOptions {
+    /// N_c of FIT1D (default 11)
+    pub n_knots_1d: usize,
+    /// knots per axis of FIT2D (default 9)
+    pub n_knots_2d: usize,
+    /// FIT2D knot extent of the in-plane pairs (default 0.9)
+    pub extent_2d: f64,
+    /// FIT2D knot extent of the pairs with a bending strain (default 0.9; 0.3 for stockinette-like patterns)
+    pub extent_2d_bending: f64,
+    /// knots per axis of the pairs with a bending strain (default 9; 5 for stockinette-like patterns)
+    pub n_knots_2d_bending: usize,
+    /// pˣ_min (default 0.001; 0.01 for stockinette-like patterns)
+    pub min_slope: f64,
+    /// MLS bandwidth factor (default 2)
+    pub bandwidth_factor: f64,
+    /// symlog ε relative to max |Ψ| (default 1e-3)
+    pub eps_rel: f64,
+    /// slope source of the 1D terms (default finite differences)
+    pub slopes: SlopeSource,
+    /// fit each 1D term to every `thin_1d`-th sample of its range only (default 1: all); the term's model error
+    /// is still measured on the whole range, so the other samples are held out (a sampling-density study)
+    pub thin_1d: usize,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        FitOptions {
+            n_knots_1d: 11,
+            n_knots_2d: 9,
+            extent_2d: 0.9,
+            extent_2d_bending: 0.9,
+            n_knots_2d_bending: 9,
+            min_slope: 1e-3,
+            bandwidth_factor: 2.0,
+            eps_rel: 1e-3,
+            slopes: SlopeSource::FiniteDifference,
+            thin_1d: 1,
+        }
+    }
+}
+
+impl FitOptions {
+    /// The design's settings for stockinette-like patterns: pˣ_min = 0.01, and the pairs with a bending strain
+    /// with 5 knots per axis on 0.3 of the range (the layout of the original stock1 material; its in-plane pairs
+    /// keep 0.9).
+    pub fn stockinette_like() -> Self {
+        FitOptions {
+            extent_2d_bending: 0.3,
+            n_knots_2d_bending: 5,
+            min_slope: 1e-2,
+            ..FitOptions::default()
+        }
+    }
+}
+
+/// Error of the model at a set of samples.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct ModelError {
+    /// converged samples compared
+    pub n_samples: usize,
+    /// samples without Ψ̄ (failed solves), not compared
+    pub n_excluded: usize,
+    /// √(Σ (ψ − Ψ̄)²) / √(Σ Ψ̄²)
+    pub rms_rel: f64,
+    /// max |ψ − Ψ̄| / max |Ψ̄|
+    pub max_rel: f64,
+    /// the sample with the largest |ψ − Ψ̄|: (z, Ψ̄, ψ)
+    pub worst: Option<([f64; 5], f64, f64)>,
+}
+
+/// One 1D term's report.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Term1DReport {
+    pub k: usize,
+    pub strain: String,
+    /// samples used / excluded (failed)
+    pub n_samples: usize,
+    pub n_excluded: usize,
+    /// FIT1D's own fit (spline + its offset against Ψ̄)
+    pub fit_rms_rel: f64,
+    pub fit_max_rel: f64,
+    /// the removed constant (Ψ̄ at the minimum knot)
+    pub offset: f64,
+    pub i_min: usize,
+    /// the whole model ψ on this range
+    pub model: ModelError,
+}
+
+/// One 2D term's report.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Term2DReport {
+    pub k0: usize,
+    pub k1: usize,
+    pub strains: [String; 2],
+    pub n_samples: usize,
+    pub n_excluded: usize,
+    /// FIT2D's unconverted spline against Ψ̄
+    pub fit_rms_rel: f64,
+    pub fit_max_rel: f64,
+    pub twist_rounds: usize,
+    pub nonmonotone_patches: usize,
+    /// the whole model ψ on this plane
+    pub model: ModelError,
+}
+
+/// The fit report (written as JSON next to the material).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FitReport {
+    pub plan_hash: String,
+    /// samples of the plan found in the file / converged among them
+    pub samples: usize,
+    pub converged: usize,
+    pub strain_scale: [f64; 5],
+    pub constant: f64,
+    /// the sample f₀ was taken from
+    pub constant_at: [f64; 5],
+    /// max |offset − f₀| over the three in-plane 1D fits (their MLS estimates of Ψ̄(0))
+    pub constant_spread: f64,
+    pub terms1d: Vec<Term1DReport>,
+    pub terms2d: Vec<Term2DReport>,
+    /// the model on every sample it was fitted to
+    pub all: ModelError,
+    pub holdout: Option<ModelError>,
+    /// the 1D curves against another material ([`compare_1d`]), when asked for
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub compare_1d: Vec<RangeComparison>,
+}
+
+/// The data one term was fitted to (for plots): normalised coordinates and Ψ̄ (NaN for failed samples).
+#[derive(Clone, Debug)]
+pub struct TermData {
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    pub psi: Vec<f64>,
+}
+
+/// A fitted material with its report and the per-term fits and data.
+#[derive(Clone, Debug)]
+pub struct MaterialFit {
+    pub material: Material,
+    pub report: FitReport,
+    pub fits1d: Vec<(usize, Fit1D, TermData)>,
+    pub fits2d: Vec<(usize, usize, Fit2D, TermData)>,
+}
+
+/// The material's six-component strain of a five-component sample strain (II₀₁ = 0).
+pub fn strain6(z: &[f64; 5]) -> [f64; 6] {
+    [z[0], z[1], z[2], z[3], 0.0, z[4]]
+}
+
+/// Error of `material` at the converged records (failed ones counted as excluded).
+pub fn model_error<'a>(
+    material: &Material,
+    records: impl IntoIterator<Item = &'a Record>,
+) -> ModelError {
+    let mut e = ModelError::default();
+    let (mut se, mut sp, mut emax, mut pmax) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    for r in records {
+        let Some(psi) = r.psi.filter(|v| v.is_finite()) else {
+            e.n_excluded += 1;
+            continue;
+        };
+        let m = material.value(&strain6(&r.z));
+        let d = m - psi;
+        e.n_samples += 1;
+        se += d * d;
+        sp += psi * psi;
+        pmax = pmax.max(psi.abs());
+        if d.abs() >= emax {
+            emax = d.abs();
+            e.worst = Some((r.z, psi, m));
+        }
+    }
+    e.rms_rel = if sp > 0.0 {
+        (se / sp).sqrt()
+    } else {
+        se.sqrt()
+    };
+    e.max_rel = if pmax > 0.0 { emax / pmax } else { emax };
+    e
+}
+
+/// The model's error on held-out samples (any sample file, e.g. a run of [`Plan::holdout`]).
+pub fn holdout_error(material: &Material, records: &[Record]) -> ModelError {
+    model_error(material, records)
+}
+
+/// Fit a material (Algorithm C5) to the records of `plan` (other records are ignored; a record whose id does not
+/// carry the plan's hash is an error, as is a plan without 1D ranges). `density` is ρ_A (kg/m²); `meta` goes into
+/// the material's `meta` block, completed with the plan hash, the options and the fit errors.
+pub fn fit_material(
+    plan: &Plan,
+    records: &[Record],
+    density: f64,
+    meta: serde_json::Map<String, serde_json::Value>,
+    opts: &FitOptions,
+) -> Result<MaterialFit, FitError> {
+    let hash = format!("{:016x}", plan.hash());
+    if plan.count_1d < 3 {
+        return Err(FitError::BadOption(format!(
+            "the plan has {} samples per 1D range; fitting needs at least 3",
+            plan.count_1d
+        )));
+    }
+    let n = plan.len();
+    let mut by_index: Vec<Option<&Record>> = vec![None; n];
+    for r in records {
+        if !r.id.starts_with(&hash) {
+            return Err(FitError::BadOption(format!(
+                "sample {} does not belong to plan {hash} (pass the plan the samples were run with)",
+                r.id
+            )));
+        }
+        if r.index < n {
+            by_index[r.index] = Some(r);
+        }
+    }
+    let present: Vec<&Record> = by_index.iter().flatten().copied().collect();
+    let converged = present.iter().filter(|r| r.psi.is_some()).count();
+
+    // strain scales
+    let samples = plan.samples();
+    let mut sigma = [0.0f64; 5];
+    for s in &samples {
+        for k in 0..5 {
+            sigma[k] = sigma[k].max(s.z[k].abs());
+        }
+    }
+    for v in &mut sigma {
+        if *v == 0.0 {
+            *v = 1.0;
+        }
+    }
+    let psi_of = |i: usize| by_index[i].and_then(|r| r.psi).unwrap_or(f64::NAN);
+
+    // 1D terms
+    let mut fits1d = Vec::new();
+    for k in 0..5 {
+        let idx: Vec<usize> = (k * plan.count_1d..(k + 1) * plan.count_1d)
+            .filter(|i| (i - k * plan.count_1d).is_multiple_of(opts.thin_1d.max(1)))
+            .collect();
+        let x: Vec<f64> = idx.iter().map(|&i| samples[i].z[k] / sigma[k]).collect();
+        let psi: Vec<f64> = idx.iter().map(|&i| psi_of(i)).collect();
+        let stress: Vec<f64> = idx
+            .iter()
+            .map(|&i| {
+                by_index[i]
+                    .and_then(|r| r.stress)
+                    .and_then(|s| s[k])
+                    .map_or(f64::NAN, |d| d * sigma[k])
+            })
+            .collect();
+        let o = Fit1DOptions {
+            n_knots: opts.n_knots_1d,
+            bandwidth_factor: opts.bandwidth_factor,
+            eps_rel: opts.eps_rel,
+            min_slope: opts.min_slope,
+            symmetric: k == 1,
+            minimum: if k < 3 {
+                MinimumAt::Zero
+            } else {
+                MinimumAt::Argmin
+            },
+            fd_step: 1e-3,
+            slopes: opts.slopes,
+        };
+        let fit = fit1d_with_stress(&x, &psi, Some(&stress), &o).map_err(|e| {
+            FitError::BadOption(format!("1D term {} ({}): {e}", k, STRAIN_NAMES[k]))
+        })?;
+        fits1d.push((k, fit, TermData { x, y: vec![], psi }));
+    }
+    // prefer the s_a range (Ψ̄ is even in s_a, so its error is second order); any sample otherwise
+    let sa_range = plan.count_1d..2 * plan.count_1d;
+    let on_sa = present
+        .iter()
+        .any(|r| sa_range.contains(&r.index) && r.psi.is_some_and(f64::is_finite));
+    let nearest = present
+        .iter()
+        .filter(|r| r.psi.is_some_and(f64::is_finite) && (!on_sa || sa_range.contains(&r.index)))
+        .map(|r| {
+            let d: f64 = (0..5).map(|k| (r.z[k] / sigma[k]).powi(2)).sum();
+            (d, *r)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .ok_or(FitError::TooFewSamples {
+            usable: 0,
+            needed: 1,
+        })?;
+    let constant = nearest.1.psi.unwrap_or(0.0);
+    let constant_at = nearest.1.z;
+    let spread = fits1d[..3]
+        .iter()
+        .map(|(_, f, _)| (f.offset - constant).abs())
+        .fold(0.0f64, f64::max);
+
+    // 2D terms
+    let mut fits2d = Vec::new();
+    let m2 = plan.count_2d;
+    for (p, [a, b]) in plan.pairs.iter().enumerate() {
+        let (ka, kb) = (
+            crate::sample::plan::strain_index(a).unwrap_or(0),
+            crate::sample::plan::strain_index(b).unwrap_or(0),
+        );
+        let (k0, k1) = (ka.min(kb), ka.max(kb));
+        let base = 5 * plan.count_1d + p * m2 * m2;
+        let idx: Vec<usize> = (base..base + m2 * m2).collect();
+        let x: Vec<f64> = idx.iter().map(|&i| samples[i].z[k0] / sigma[k0]).collect();
+        let y: Vec<f64> = idx.iter().map(|&i| samples[i].z[k1] / sigma[k1]).collect();
+        let psi: Vec<f64> = idx.iter().map(|&i| psi_of(i)).collect();
+        let stretch = |k: usize| k == 0 || k == 2;
+        let bending = k1 >= 3;
+        let o = Fit2DOptions {
+            n_knots: [if bending {
+                opts.n_knots_2d_bending
+            } else {
+                opts.n_knots_2d
+            }; 2],
+            extent: if bending {
+                opts.extent_2d_bending
+            } else {
+                opts.extent_2d
+            },
+            bandwidth_factor: opts.bandwidth_factor,
+            eps_rel: opts.eps_rel,
+            min_slope: opts.min_slope,
+            symmetric: [k0 == 1, k1 == 1],
+            quasi_convex: !(k0 == 0 && k1 == 2),
+            minimum_v: if k1 < 3 {
+                MinimumAt::Zero
+            } else {
+                MinimumAt::Argmin
+            },
+            stretch: [stretch(k0), stretch(k1)],
+            fd_step: 1e-3,
+        };
+        let fit = fit2d(&x, &y, &psi, &o).map_err(|e| {
+            FitError::BadOption(format!(
+                "2D term ({}, {}): {e}",
+                STRAIN_NAMES[k0], STRAIN_NAMES[k1]
+            ))
+        })?;
+        fits2d.push((k0, k1, fit, TermData { x, y, psi }));
+    }
+
+    let mut material = Material {
+        density,
+        strain_scale: sigma,
+        constant,
+        terms1d: fits1d
+            .iter()
+            .map(|(k, f, _)| Term1D {
+                k: *k,
+                spline: f.spline.clone(),
+            })
+            .collect(),
+        terms2d: fits2d
+            .iter()
+            .map(|(k0, k1, f, _)| Term2D {
+                k0: *k0,
+                k1: *k1,
+                spline: f.residual.clone(),
+            })
+            .collect(),
+        extra: serde_json::Map::new(),
+    };
+
+    // reports
+    let recs = |range: std::ops::Range<usize>| -> Vec<&Record> {
+        range.filter_map(|i| by_index[i]).collect::<Vec<_>>()
+    };
+    let terms1d: Vec<Term1DReport> = fits1d
+        .iter()
+        .map(|(k, f, _)| Term1DReport {
+            k: *k,
+            strain: STRAIN_NAMES[*k].to_string(),
+            n_samples: f.report.n_samples,
+            n_excluded: f.report.n_excluded,
+            fit_rms_rel: f.report.rms_rel,
+            fit_max_rel: f.report.max_rel,
+            offset: f.offset,
+            i_min: f.report.i_min,
+            model: model_error(&material, recs(k * plan.count_1d..(k + 1) * plan.count_1d)),
+        })
+        .collect();
+    let terms2d: Vec<Term2DReport> = fits2d
+        .iter()
+        .enumerate()
+        .map(|(p, (k0, k1, f, _))| {
+            let base = 5 * plan.count_1d + p * m2 * m2;
+            Term2DReport {
+                k0: *k0,
+                k1: *k1,
+                strains: [STRAIN_NAMES[*k0].to_string(), STRAIN_NAMES[*k1].to_string()],
+                n_samples: f.report.n_samples,
+                n_excluded: f.report.n_excluded,
+                fit_rms_rel: f.report.rms_rel,
+                fit_max_rel: f.report.max_rel,
+                twist_rounds: f.report.twist_rounds,
+                nonmonotone_patches: f.report.nonmonotone_patches,
+                model: model_error(&material, recs(base..base + m2 * m2)),
+            }
+        })
+        .collect();
+    let all = model_error(&material, recs(0..plan.grid_start()));
+    // the plan's own in-plane grid is held out: never fitted, only predicted
+    let holdout = plan
+        .grid
+        .as_ref()
+        .map(|_| model_error(&material, recs(plan.grid_start()..n)));
+    let report = FitReport {
+        plan_hash: hash.clone(),
+        samples: present.len(),
+        converged,
+        strain_scale: sigma,
+        constant,
+        constant_at,
+        constant_spread: spread,
+        terms1d,
+        terms2d,
+        all,
+        holdout,
+        compare_1d: vec![],
+    };
+
+    let mut meta = meta;
+    meta.insert("plan".into(), serde_json::json!(hash));
+    meta.insert(
+        "fit options".into(),
+        serde_json::json!({
+            "n_knots_1d": opts.n_knots_1d, "n_knots_2d": opts.n_knots_2d, "extent_2d": opts.extent_2d,
+            "n_knots_2d_bending": opts.n_knots_2d_bending, "extent_2d_bending": opts.extent_2d_bending,
+            "min_slope": opts.min_slope, "bandwidth_factor": opts.bandwidth_factor, "eps_rel": opts.eps_rel,
+            "slopes": format!("{:?}", opts.slopes), "thin_1d": opts.thin_1d,
+        }),
+    );
+    meta.insert(
+        "fit errors".into(),
+        serde_json::json!({
+            "samples": report.samples, "converged": report.converged,
+            "model_rms_rel": report.all.rms_rel, "model_max_rel": report.all.max_rel,
+            "constant_spread": spread,
+            "holdout": report.holdout.as_ref().map(|h| serde_json::json!({
+                "samples": h.n_samples, "rms_rel": h.rms_rel, "max_rel": h.max_rel })),
+            "1D": report.terms1d.iter().map(|t| serde_json::json!({
+                "strain": t.strain, "rms_rel": t.model.rms_rel, "max_rel": t.model.max_rel,
+                "excluded": t.n_excluded })).collect::<Vec<_>>(),
+            "2D": report.terms2d.iter().map(|t| serde_json::json!({
+                "strains": t.strains, "rms_rel": t.model.rms_rel, "max_rel": t.model.max_rel,
+                "excluded": t.n_excluded, "nonmonotone_patches": t.nonmonotone_patches })).collect::<Vec<_>>(),
+        }),
+    );
+    material.extra.insert(
+        "strain shift".into(),
+        serde_json::json!([1.0, 0.0, 1.0, 0.0, 0.0]),
+    );
+    material
+        .extra
+        .insert("meta".into(), serde_json::Value::Object(meta));
+    Ok(MaterialFit {
+        material,
+        report,
+        fits1d,
+        fits2d,
+    })
+}
+
+/// One 1D range compared with another material (validation item 3d).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RangeComparison {
+    pub k: usize,
+    pub strain: String,
+    /// points compared (the plan's values of the range inside the other material's sampled range)
+    pub n_points: usize,
+    /// the compared interval of strain k
+    pub interval: [f64; 2],
+    /// our fitted f₀ + f_k against the other material's f₀ + f_k: RMS of the difference over RMS of theirs
+    pub fit_rms_rel: f64,
+    /// our converged samples Ψ̄ against the other material's f₀ + f_k (same normalisation)
+    pub samples_rms_rel: f64,
+    /// our f₀ + f_k and theirs at the two ends of the interval
+    pub ends: [[f64; 2]; 2],
+}
+
+/// Compare the 1D curves f₀ + f_k of a fitted material with another material's (the original's) along the
+/// plan's 1D ranges, restricted to the other material's sampled range (its knot span / 0.95, times its strain
+/// scale). `records` supply our own Ψ̄ at the same strains.
+pub fn compare_1d(
+    fit: &MaterialFit,
+    plan: &Plan,
+    records: &[Record],
+    other: &Material,
+) -> Vec<RangeComparison> {
+    let samples = plan.samples();
+    let mut psi = vec![None; plan.len()];
+    for r in records {
+        if r.index < psi.len() {
+            psi[r.index] = r.psi;
+        }
+    }
+    let mut out = Vec::new();
+    for k in 0..5 {
+        let Some(term) = other.terms1d.iter().find(|t| t.k == k) else {
+            continue;
+        };
+        let t = &term.spline.t;
+        let sig = other.strain_scale[k];
+        let interval = [t[0] / 0.95 * sig, t[t.len() - 1] / 0.95 * sig];
+        let (mut d2, mut o2, mut s2, mut so2, mut n) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0);
+        let mut ends = [[f64::NAN; 2]; 2];
+        let mut first = true;
+        for i in k * plan.count_1d..(k + 1) * plan.count_1d {
+            let z = samples[i].z;
+            if z[k] < interval[0] - 1e-12 || z[k] > interval[1] + 1e-12 {
+                continue;
+            }
+            let z6 = strain6(&z);
+            let (ours, theirs) = (fit.material.value(&z6), other.value(&z6));
+            if first {
+                ends[0] = [ours, theirs];
+                first = false;
+            }
+            ends[1] = [ours, theirs];
+            n += 1;
+            d2 += (ours - theirs).powi(2);
+            o2 += theirs * theirs;
+            if let Some(p) = psi[i].filter(|v| v.is_finite()) {
+                s2 += (p - theirs).powi(2);
+                so2 += theirs * theirs;
+            }
+        }
+        out.push(RangeComparison {
+            k,
+            strain: STRAIN_NAMES[k].to_string(),
+            n_points: n,
+            interval,
+            fit_rms_rel: (d2 / o2.max(1e-300)).sqrt(),
+            samples_rms_rel: (s2 / so2.max(1e-300)).sqrt(),
+            ends,
+        });
+    }
+    out
+}

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Validation of sampling and fitting (issue 5; `../shared/design/06-verification.md`, item 3d) on the five original
+# patterns. For each pattern, one sample run of `validation/plans/<pattern>.json`: the five 1D ranges (150 samples
+# each, over the range the original material was fitted on: its knot span / 0.95 times its strain scale), the
+# three in-plane 2D grids (20×20), and the 9×9×9 in-plane grid of the original displacement data, which is held
+# out (never fitted, only predicted). Then `hylc fit` against the original material (`--compare`).
+# Writes validation/fit/<pattern>.{jsonl,meta.json,material.json,fit.json,plots/} and prints the tables.
+#
+#   cargo build --release && validation/fit_originals.sh            # all five (about an hour on 2 cores)
+#   validation/fit_originals.sh basket satin                        # some of them
+#
+# Resumable: rerunning skips finished samples.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+HYLC=${HYLC:-target/release/hylc}
+D=${HYLC_SHARED:-../shared}/data/hylc2020
+OUT=validation/fit
+if [ ! -d "$D" ]; then
+  echo "skipped: $D not found (set HYLC_SHARED)"; exit 0
+fi
+mkdir -p "$OUT"
+declare -A MAT=([basket]=basket1 [satin]=satin1 [slip_stitch_honeycomb]=honey1 [stockinette]=stock1 [cartridge_belt_rib]=rib1)
+PATTERNS=("$@")
+[ ${#PATTERNS[@]} -eq 0 ] && PATTERNS=(basket satin slip_stitch_honeycomb stockinette cartridge_belt_rib)
+for pat in "${PATTERNS[@]}"; do
+  mat=${MAT[$pat]:?unknown pattern $pat}
+  flags=""
+  [ "$pat" = stockinette ] && flags=--stockinette-like
+  echo "== $pat"
+  /usr/bin/time -f "sample wall time %e s" "$HYLC" sample "$D/patterns/$pat.pyp" --plan "validation/plans/$pat.json" \
+    --out "$OUT/$pat.jsonl"
+  rc=$?
+  if [ $rc -ne 0 ] && [ $rc -ne 3 ]; then echo "sample failed ($rc)"; exit $rc; fi
+  "$HYLC" fit "$OUT/$pat.jsonl" --compare "$D/materials/$mat.json" $flags || exit $?
+done
