@@ -1,7 +1,7 @@
 //! Property tests of FIT2D (issue 5; `04-sampling-fitting.md`, "Fitting (C5, C6, C7)", FIT2D): random noisy grid
 //! samples of random quasi-convex ground truths give a fitted surface f that is quasi-convex (monotone on each side
-//! of its minimum) along every knot row and column, on a dense grid reaching 50 % beyond the knots, with knot slopes
-//! that respect pˣ_min; the residual term vanishes on both axes and on the compressed half-plane; the 2D MLS
+//! of its minimum) along every knot row and column, on a dense grid reaching 50 % beyond the knots, and monotone
+//! inside the patches away from the minimum's row and column, with knot slopes that respect pˣ_min; the residual term vanishes on both axes and on the compressed half-plane; the 2D MLS
 //! reproduces quadratics; noise-free samples of a smooth convex function are reproduced at the knots.
 
 use hylc::fit::{fit2d, Fit2DOptions, MinimumAt, Mls2D};
@@ -147,6 +147,45 @@ fn dense(t: &[f64], n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Inside the patches: along the mid-lines between knot rows (columns), f is monotone in u (v) on each side of
+/// the minimum, away from the cells that touch the minimum's column (row), which FIT2D leaves quasi-convex only.
+fn check_mid_lines(s: &Hermite2D, i_min: usize, j_min: usize) -> Result<(), TestCaseError> {
+    let scale = s.p.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
+    let tol = 1e-10 * scale;
+    let n = 400;
+    // (knots along the line, minimum knot, knots across, evaluation at (along, across))
+    let rows = |a: f64, b: f64| s.eval2(a, b)[0];
+    let cols = |a: f64, b: f64| s.eval2(b, a)[0];
+    let dirs: [(&[f64], usize, &[f64], &dyn Fn(f64, f64) -> f64, &str); 2] = [
+        (&s.tu, i_min, &s.tv, &rows, "mid-row"),
+        (&s.tv, j_min, &s.tu, &cols, "mid-column"),
+    ];
+    for (along, min, across, f, what) in dirs {
+        for j in 0..across.len() - 1 {
+            let c = 0.5 * (across[j] + across[j + 1]);
+            for (lo, hi, sign) in [
+                (min + 1, along.len() - 1, 1.0),
+                (0, min.saturating_sub(1), -1.0),
+            ] {
+                if hi <= lo {
+                    continue;
+                }
+                let (a, b) = (along[lo], along[hi]);
+                let vals: Vec<f64> = (0..=n)
+                    .map(|k| f(a + (b - a) * k as f64 / n as f64, c))
+                    .collect();
+                for k in 1..=n {
+                    prop_assert!(
+                        sign * (vals[k] - vals[k - 1]) >= -tol,
+                        "{what} at {c}: not monotone at step {k}/{n} of [{a}, {b}]"
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 fn check_grid_lines(s: &Hermite2D) -> Result<(), TestCaseError> {
     for (j, &v) in s.tv.iter().enumerate() {
         let line: Vec<f64> = dense(&s.tu, 1500)
@@ -178,6 +217,8 @@ proptest! {
         prop_assert_eq!(f.tu[i_min], 0.0);
         if c.opts.quasi_convex {
             check_grid_lines(f)?;
+            prop_assert_eq!(fit.report.nonmonotone_patches, 0, "{:?}", fit.report);
+            check_mid_lines(f, i_min, j_min)?;
             let pmin = c.opts.min_slope;
             for j in 0..nv {
                 for i in 0..nu {

@@ -244,6 +244,10 @@ enum Command {
         /// fit the 1D terms to every K-th sample of their ranges only (the others are held out)
         #[arg(long, default_value_t = 1, value_name = "K")]
         thin_1d: usize,
+        /// stop FIT2D's monotone correction after the twists (report non-monotone patches instead of shrinking
+        /// the cross slopes)
+        #[arg(long)]
+        twist_only: bool,
     },
     /// Compute the reference state of a pattern (Algorithm C1: stress-free state, tension, zero-stress periods,
     /// centring) and write it as `.pyp`.
@@ -452,6 +456,7 @@ fn main() -> ExitCode {
             extent,
             slopes,
             thin_1d,
+            twist_only,
         } => (|| {
             let mut options = if stockinette_like {
                 hylc::fit::FitOptions::stockinette_like()
@@ -468,6 +473,7 @@ fn main() -> ExitCode {
             }
             options.slopes = fit::parse_slopes(&slopes)?;
             options.thin_1d = thin_1d.max(1);
+            options.strict_patches = !twist_only;
             let out = out.unwrap_or_else(|| samples.with_extension("material.json"));
             let report = report.unwrap_or_else(|| samples.with_extension("fit.json"));
             let plots = plots.unwrap_or_else(|| samples.with_extension("plots"));

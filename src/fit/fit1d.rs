@@ -108,16 +108,7 @@ fn check_options(o: &Fit1DOptions) -> Result<(), FitError> {
     if o.n_knots < 2 {
         return bad(format!("n_knots = {} (need ≥ 2)", o.n_knots));
     }
-    if !(o.eps_rel.is_finite() && o.eps_rel > 0.0) {
-        return bad(format!("eps_rel = {} (need finite, > 0)", o.eps_rel));
-    }
-    if !(o.min_slope.is_finite() && o.min_slope > 0.0) {
-        return bad(format!("min_slope = {} (need finite, > 0)", o.min_slope));
-    }
-    if !(o.fd_step.is_finite() && o.fd_step > 0.0 && o.fd_step <= 0.5) {
-        return bad(format!("fd_step = {} (need in (0, 0.5])", o.fd_step));
-    }
-    Ok(())
+    super::check_common(o.eps_rel, o.min_slope, o.fd_step)
 }
 
 /// FIT1D on samples `x` (normalised strain) and `psi` (energy density). Samples where either is not finite are

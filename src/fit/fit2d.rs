@@ -22,8 +22,11 @@
 //!    along every grid line outward from the minimum. Inside the patches monotonicity also depends on the twists
 //!    pˣʸ. Carlson & Fritsch (1985) give sufficient conditions; not having them, we check the sign of ∂f/∂u
 //!    (∂f/∂v) on a 7 × 7 grid of every patch not touching the minimum's column (row) and halve the four corner
-//!    twists of each failing patch, up to 40 rounds, then zero them. Patches that still fail (a twist-free patch
-//!    can be non-monotone when pʸ varies strongly along u) are counted in the report, not hidden.
+//!    twists of each failing patch, up to 40 rounds. A twist-free patch can still be non-monotone in u when pʸ
+//!    varies strongly along u, so then (up to 60 rounds) the corners of each failing patch get pˣʸ = 0 and |pʸ|
+//!    (for a failure along u; |pˣ| along v) halved, never below pˣ_min and never changing sign, which keeps the
+//!    grid lines monotone; in the limit (all cross slopes ±pˣ_min) the offending term vanishes. Patches that
+//!    still fail are counted in the report, not hidden.
 //! 6. Residual: r(u, v) = f(u, v) − f(u, 0) − f(0, v) + f(0, 0), i.e. on the knots p − p(·, 0) − p(0, ·) + p(0, 0),
 //!    pˣ − pˣ(·, 0), pʸ − pʸ(0, ·) and pˣʸ unchanged. This is exact as a function (f(u, 0) and f(0, v) are
 //!    bicubics themselves), so r vanishes identically on both axes, extrapolation included.
@@ -64,6 +67,9 @@ pub struct Fit2DOptions {
     pub stretch: [bool; 2],
     /// central-difference step as a fraction of the smallest knot spacing (default 1e-3)
     pub fd_step: f64,
+    /// after the twists, also shrink the cross slopes of failing patches until every patch is monotone (default
+    /// true); false stops after the twists and only counts the failing patches
+    pub strict_patches: bool,
 }
 
 impl Default for Fit2DOptions {
@@ -79,6 +85,7 @@ impl Default for Fit2DOptions {
             minimum_v: MinimumAt::Zero,
             stretch: [false, false],
             fd_step: 1e-3,
+            strict_patches: true,
         }
     }
 }
@@ -98,6 +105,8 @@ pub struct Fit2DReport {
     pub j_min: usize,
     /// rounds of twist halving that step 5 needed
     pub twist_rounds: usize,
+    /// rounds of cross-slope shrinking that step 5 needed after the twists
+    pub slope_rounds: usize,
     /// patches still failing the monotonicity check of step 5
     pub nonmonotone_patches: usize,
 }
@@ -147,16 +156,7 @@ fn check_options(o: &Fit2DOptions) -> Result<(), FitError> {
     if !(o.extent.is_finite() && o.extent > 0.0 && o.extent <= 1.0) {
         return bad(format!("extent = {} (need in (0, 1])", o.extent));
     }
-    if !(o.eps_rel.is_finite() && o.eps_rel > 0.0) {
-        return bad(format!("eps_rel = {} (need finite, > 0)", o.eps_rel));
-    }
-    if !(o.min_slope.is_finite() && o.min_slope > 0.0) {
-        return bad(format!("min_slope = {} (need finite, > 0)", o.min_slope));
-    }
-    if !(o.fd_step.is_finite() && o.fd_step > 0.0 && o.fd_step <= 0.5) {
-        return bad(format!("fd_step = {} (need in (0, 0.5])", o.fd_step));
-    }
-    Ok(())
+    super::check_common(o.eps_rel, o.min_slope, o.fd_step)
 }
 
 /// Fritsch–Carlson limits along one grid line (step 5): `p`, `m` are the values and slopes at `t`; `min` is the
@@ -176,6 +176,13 @@ fn limit_line(t: &[f64], p: &[f64], m: &mut [f64], min: Option<usize>) {
             }
         }
     }
+}
+
+/// A patch failing the interior monotonicity check, and in which direction.
+struct Failing {
+    cell: (usize, usize),
+    along_u: bool,
+    along_v: bool,
 }
 
 /// Grid data of a bicubic Hermite spline with u inner: index j·nu + i.
@@ -205,7 +212,7 @@ impl Grid {
     }
 
     /// Patches failing the interior monotonicity check of step 5 (sign of ∂f/∂u and ∂f/∂v away from the minimum).
-    fn failing_patches(&self, i_min: usize, j_min: usize) -> Vec<(usize, usize)> {
+    fn failing_patches(&self, i_min: usize, j_min: usize) -> Vec<Failing> {
         let s = self.spline();
         let scale = self
             .p
@@ -226,20 +233,22 @@ impl Grid {
                 let (hu, hv) = (self.tu[ci + 1] - self.tu[ci], self.tv[cj + 1] - self.tv[cj]);
                 let tol_u = 1e-10 * scale / hu;
                 let tol_v = 1e-10 * scale / hv;
-                let mut bad = false;
-                'pts: for a in 0..=6 {
+                let (mut fx, mut fy) = (false, false);
+                for a in 0..=6 {
                     for b in 0..=6 {
                         let u = self.tu[ci] + hu * a as f64 / 6.0;
                         let v = self.tv[cj] + hv * b as f64 / 6.0;
                         let d = s.eval2(u, v);
-                        if (check_x && sx * d[1] < -tol_u) || (check_y && sy * d[2] < -tol_v) {
-                            bad = true;
-                            break 'pts;
-                        }
+                        fx |= check_x && sx * d[1] < -tol_u;
+                        fy |= check_y && sy * d[2] < -tol_v;
                     }
                 }
-                if bad {
-                    out.push((ci, cj));
+                if fx || fy {
+                    out.push(Failing {
+                        cell: (ci, cj),
+                        along_u: fx,
+                        along_v: fy,
+                    });
                 }
             }
         }
@@ -427,24 +436,25 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
         }
     }
     clamp_boundary(&mut grid);
-    // twists: halve at the corners of failing patches, then zero
+    // twists: halve at the corners of failing patches, then zero; then shrink the cross slopes (see below)
     let mut twist_rounds = 0;
+    let mut slope_rounds = 0;
     let mut nonmonotone_patches = 0;
     if opts.quasi_convex {
         let corners = |grid: &Grid, (ci, cj): (usize, usize)| {
             [
-                grid.at(ci, cj),
-                grid.at(ci + 1, cj),
-                grid.at(ci, cj + 1),
-                grid.at(ci + 1, cj + 1),
+                (ci, cj, grid.at(ci, cj)),
+                (ci + 1, cj, grid.at(ci + 1, cj)),
+                (ci, cj + 1, grid.at(ci, cj + 1)),
+                (ci + 1, cj + 1, grid.at(ci + 1, cj + 1)),
             ]
         };
         let mut failing = grid.failing_patches(i_min, j_min);
         while !failing.is_empty() && twist_rounds < 40 {
             twist_rounds += 1;
             let mut seen = std::collections::HashSet::new();
-            for &pc in &failing {
-                for k in corners(&grid, pc) {
+            for f in &failing {
+                for (_, _, k) in corners(&grid, f.cell) {
                     if seen.insert(k) {
                         grid.muv[k] *= 0.5;
                     }
@@ -452,14 +462,37 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
             }
             failing = grid.failing_patches(i_min, j_min);
         }
-        if !failing.is_empty() {
-            for &pc in &failing {
-                for k in corners(&grid, pc) {
+        // A twist-free patch can still change monotonicity in u when pʸ differs strongly between its corners (the
+        // ∂f/∂u of the patch contains hv k_j(t) ∂_u H[pʸ]); shrinking |pʸ| towards pˣ_min (keeping its sign, so the
+        // columns stay monotone and Fritsch–Carlson's box still holds) removes that term in the limit, and
+        // likewise |pˣ| for a failure along v.
+        while opts.strict_patches && !failing.is_empty() && slope_rounds < 60 {
+            slope_rounds += 1;
+            let mut seen = std::collections::HashSet::new();
+            for f in &failing {
+                for (i, j, k) in corners(&grid, f.cell) {
+                    if !seen.insert(k) {
+                        continue;
+                    }
                     grid.muv[k] = 0.0;
+                    let shrink = |m: f64, free: bool| {
+                        if free {
+                            0.5 * m
+                        } else {
+                            (0.5 * m.abs()).max(pmin).copysign(m)
+                        }
+                    };
+                    if f.along_u {
+                        grid.mv[k] = shrink(grid.mv[k], j == j_min);
+                    }
+                    if f.along_v {
+                        grid.mu[k] = shrink(grid.mu[k], i == i_min);
+                    }
                 }
             }
-            nonmonotone_patches = grid.failing_patches(i_min, j_min).len();
+            failing = grid.failing_patches(i_min, j_min);
         }
+        nonmonotone_patches = failing.len();
     }
     let full = grid.spline();
 
@@ -530,6 +563,7 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
         i_min,
         j_min,
         twist_rounds,
+        slope_rounds,
         nonmonotone_patches,
     };
     Ok(Fit2D {

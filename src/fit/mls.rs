@@ -39,26 +39,10 @@ impl Mls1D {
                 x[i], y[i]
             )));
         }
-        let mut sorted = x.to_vec();
-        sorted.sort_by(f64::total_cmp);
-        let mut gaps: Vec<f64> = sorted
-            .windows(2)
-            .map(|w| w[1] - w[0])
-            .filter(|&g| g > 0.0)
-            .collect();
-        if gaps.len() < 2 {
-            return Err(FitError::TooFewSamples {
-                usable: gaps.len() + usize::from(!x.is_empty()),
-                needed: 3,
-            });
-        }
-        gaps.sort_by(f64::total_cmp);
-        let n = gaps.len();
-        let median = if n % 2 == 1 {
-            gaps[n / 2]
-        } else {
-            0.5 * (gaps[n / 2 - 1] + gaps[n / 2])
-        };
+        let median = median_spacing(x).map_err(|distinct| FitError::TooFewSamples {
+            usable: distinct,
+            needed: 3,
+        })?;
         Ok(Mls1D {
             x: x.to_vec(),
             y: y.to_vec(),
@@ -115,8 +99,9 @@ impl Mls1D {
     }
 }
 
-/// Median of the positive gaps between the sorted distinct values of `x` (None when fewer than two gaps).
-fn median_spacing(x: &[f64]) -> Option<f64> {
+/// Median of the positive gaps between the sorted distinct values of `x`; the number of distinct values when there
+/// are fewer than three.
+fn median_spacing(x: &[f64]) -> Result<f64, usize> {
     let mut sorted = x.to_vec();
     sorted.sort_by(f64::total_cmp);
     let mut gaps: Vec<f64> = sorted
@@ -125,11 +110,11 @@ fn median_spacing(x: &[f64]) -> Option<f64> {
         .filter(|&g| g > 0.0)
         .collect();
     if gaps.len() < 2 {
-        return None;
+        return Err(gaps.len() + usize::from(!x.is_empty()));
     }
     gaps.sort_by(f64::total_cmp);
     let n = gaps.len();
-    Some(if n % 2 == 1 {
+    Ok(if n % 2 == 1 {
         gaps[n / 2]
     } else {
         0.5 * (gaps[n / 2 - 1] + gaps[n / 2])
@@ -169,12 +154,12 @@ impl Mls2D {
                 x[i], y[i], f[i]
             )));
         }
-        let too_few = || FitError::TooFewSamples {
-            usable: x.len(),
-            needed: 9,
+        let too_few = |distinct: usize| FitError::TooFewSamples {
+            usable: distinct,
+            needed: 3,
         };
-        let bu = median_spacing(x).ok_or_else(too_few)?;
-        let bv = median_spacing(y).ok_or_else(too_few)?;
+        let bu = median_spacing(x).map_err(too_few)?;
+        let bv = median_spacing(y).map_err(too_few)?;
         Ok(Mls2D {
             x: x.to_vec(),
             y: y.to_vec(),

@@ -51,3 +51,18 @@ impl fmt::Display for FitError {
 }
 
 impl std::error::Error for FitError {}
+
+/// The option checks FIT1D and FIT2D share: ε, pˣ_min and the finite-difference step.
+fn check_common(eps_rel: f64, min_slope: f64, fd_step: f64) -> Result<(), FitError> {
+    let bad = |s: String| Err(FitError::BadOption(s));
+    if !(eps_rel.is_finite() && eps_rel > 0.0) {
+        return bad(format!("eps_rel = {eps_rel} (need finite, > 0)"));
+    }
+    if !(min_slope.is_finite() && min_slope > 0.0) {
+        return bad(format!("min_slope = {min_slope} (need finite, > 0)"));
+    }
+    if !(fd_step.is_finite() && fd_step > 0.0 && fd_step <= 0.5) {
+        return bad(format!("fd_step = {fd_step} (need in (0, 0.5])"));
+    }
+    Ok(())
+}

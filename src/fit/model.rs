@@ -47,6 +47,8 @@ pub struct FitOptions {
     pub eps_rel: f64,
     /// slope source of the 1D terms (default finite differences)
     pub slopes: SlopeSource,
+    /// FIT2D's strict patch monotonicity (default true; see [`Fit2DOptions::strict_patches`])
+    pub strict_patches: bool,
     /// fit each 1D term to every `thin_1d`-th sample of its range only (default 1: all); the term's model error
     /// is still measured on the whole range, so the other samples are held out (a sampling-density study)
     pub thin_1d: usize,
@@ -65,6 +67,7 @@ impl Default for FitOptions {
             eps_rel: 1e-3,
             slopes: SlopeSource::FiniteDifference,
             thin_1d: 1,
+            strict_patches: true,
         }
     }
 }
@@ -128,6 +131,7 @@ pub struct Term2DReport {
     pub fit_rms_rel: f64,
     pub fit_max_rel: f64,
     pub twist_rounds: usize,
+    pub slope_rounds: usize,
     pub nonmonotone_patches: usize,
     /// the whole model ψ on this plane
     pub model: ModelError,
@@ -362,6 +366,7 @@ pub fn fit_material(
             },
             stretch: [stretch(k0), stretch(k1)],
             fd_step: 1e-3,
+            strict_patches: opts.strict_patches,
         };
         let fit = fit2d(&x, &y, &psi, &o).map_err(|e| {
             FitError::BadOption(format!(
@@ -426,6 +431,7 @@ pub fn fit_material(
                 fit_rms_rel: f.report.rms_rel,
                 fit_max_rel: f.report.max_rel,
                 twist_rounds: f.report.twist_rounds,
+                slope_rounds: f.report.slope_rounds,
                 nonmonotone_patches: f.report.nonmonotone_patches,
                 model: model_error(&material, recs(base..base + m2 * m2)),
             }
@@ -461,6 +467,7 @@ pub fn fit_material(
             "n_knots_2d_bending": opts.n_knots_2d_bending, "extent_2d_bending": opts.extent_2d_bending,
             "min_slope": opts.min_slope, "bandwidth_factor": opts.bandwidth_factor, "eps_rel": opts.eps_rel,
             "slopes": format!("{:?}", opts.slopes), "thin_1d": opts.thin_1d,
+            "strict_patches": opts.strict_patches,
         }),
     );
     meta.insert(
@@ -507,6 +514,9 @@ pub struct RangeComparison {
     pub fit_rms_rel: f64,
     /// our converged samples Ψ̄ against the other material's f₀ + f_k (same normalisation)
     pub samples_rms_rel: f64,
+    /// the terms alone, f_k against theirs (each material's f₀ removed): the shape of the response without the
+    /// energy of the zero-strain state
+    pub term_rms_rel: f64,
     /// our f₀ + f_k and theirs at the two ends of the interval
     pub ends: [[f64; 2]; 2],
 }
@@ -536,6 +546,7 @@ pub fn compare_1d(
         let sig = other.strain_scale[k];
         let interval = [t[0] / 0.95 * sig, t[t.len() - 1] / 0.95 * sig];
         let (mut d2, mut o2, mut s2, mut so2, mut n) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0);
+        let (mut t2, mut to2) = (0.0f64, 0.0f64);
         let mut ends = [[f64::NAN; 2]; 2];
         let mut first = true;
         for i in k * plan.count_1d..(k + 1) * plan.count_1d {
@@ -551,6 +562,9 @@ pub fn compare_1d(
             }
             ends[1] = [ours, theirs];
             n += 1;
+            let (fo, ft) = (ours - fit.material.constant, theirs - other.constant);
+            t2 += (fo - ft).powi(2);
+            to2 += ft * ft;
             d2 += (ours - theirs).powi(2);
             o2 += theirs * theirs;
             if let Some(p) = psi[i].filter(|v| v.is_finite()) {
@@ -565,6 +579,7 @@ pub fn compare_1d(
             interval,
             fit_rms_rel: (d2 / o2.max(1e-300)).sqrt(),
             samples_rms_rel: (s2 / so2.max(1e-300)).sqrt(),
+            term_rms_rel: (t2 / to2.max(1e-300)).sqrt(),
             ends,
         });
     }

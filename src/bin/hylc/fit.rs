@@ -218,16 +218,17 @@ pub fn fit(
                 .as_ref()
                 .map_or(String::new(), |p| p.display().to_string())
         );
-        println!("strain   points  interval             our fit  our samples");
+        println!("strain   points  interval             our fit  our samples  f_k alone");
         for c in &r.compare_1d {
             println!(
-                "{:<8} {:>6}  [{:>8.3}, {:>8.3}]  {:>7.3}  {:>11.3}",
+                "{:<8} {:>6}  [{:>8.3}, {:>8.3}]  {:>7.3}  {:>11.3}  {:>9.3}",
                 c.strain,
                 c.n_points,
                 c.interval[0],
                 c.interval[1],
                 c.fit_rms_rel,
-                c.samples_rms_rel
+                c.samples_rms_rel,
+                c.term_rms_rel
             );
         }
     }
