@@ -149,6 +149,16 @@ fn dense(t: &[f64], n: usize) -> Vec<f64> {
 
 /// Inside the patches: along the mid-lines between knot rows (columns), f is monotone in u (v) on each side of
 /// the minimum, away from the cells that touch the minimum's column (row), which FIT2D leaves quasi-convex only.
+/// One direction of the mid-line check: knots along the line, the minimum knot, knots across, f at (along,
+/// across), and a name.
+type Direction<'a> = (
+    &'a [f64],
+    usize,
+    &'a [f64],
+    &'a dyn Fn(f64, f64) -> f64,
+    &'a str,
+);
+
 fn check_mid_lines(s: &Hermite2D, i_min: usize, j_min: usize) -> Result<(), TestCaseError> {
     let scale = s.p.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1e-300);
     let tol = 1e-10 * scale;
@@ -156,7 +166,7 @@ fn check_mid_lines(s: &Hermite2D, i_min: usize, j_min: usize) -> Result<(), Test
     // (knots along the line, minimum knot, knots across, evaluation at (along, across))
     let rows = |a: f64, b: f64| s.eval2(a, b)[0];
     let cols = |a: f64, b: f64| s.eval2(b, a)[0];
-    let dirs: [(&[f64], usize, &[f64], &dyn Fn(f64, f64) -> f64, &str); 2] = [
+    let dirs: [Direction; 2] = [
         (&s.tu, i_min, &s.tv, &rows, "mid-row"),
         (&s.tv, j_min, &s.tu, &cols, "mid-column"),
     ];

@@ -90,6 +90,11 @@ pub struct Plan {
     pub count_2d: usize,
     /// The strain pairs of the 2D grids, by name (`s_x`, `s_a`, `s_y`, `II00`, `II11`).
     pub pairs: Vec<[String; 2]>,
+    /// Optional ranges of the 2D grids, one [[min, max], [min, max]] per pair (Algorithm C4 takes 2D ranges
+    /// separately from the 1D ones; the original materials' grids span e.g. s_x ∈ [−0.1, 0.84] where their 1D
+    /// range reaches −0.64). Absent (the default): the grids use `ranges`. Each must contain 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ranges_2d: Option<Vec<[[f64; 2]; 2]>>,
     /// An optional tensor grid of in-plane strains (s_x, s_a, s_y all varying, no bending): held-out samples
     /// off the sampled planes, which the additive model must predict (`04-sampling-fitting.md`, "Quality
     /// report"). Absent from the JSON (and from the hash) when `None`.
@@ -156,6 +161,7 @@ impl Default for Plan {
             count_1d: 150,
             count_2d: 50,
             pairs: default_pairs(),
+            ranges_2d: None,
             grid: None,
         }
     }
@@ -302,6 +308,29 @@ impl Plan {
                 ));
             }
         }
+        if let Some(r2) = &self.ranges_2d {
+            if r2.len() != self.pairs.len() {
+                return Err(err(
+                    "ranges_2d".into(),
+                    format!("{} entries for {} pairs", r2.len(), self.pairs.len()),
+                ));
+            }
+            for (p, sides) in r2.iter().enumerate() {
+                for (side, &[lo, hi]) in sides.iter().enumerate() {
+                    let k = strain_index(&self.pairs[p][side]).unwrap_or(1);
+                    if !(lo.is_finite() && hi.is_finite() && lo <= 0.0 && 0.0 <= hi)
+                        || ((k == 0 || k == 2) && lo <= -1.0)
+                    {
+                        return Err(err(
+                            format!("ranges_2d[{p}][{side}]"),
+                            format!(
+                                "[{lo}, {hi}] must be a finite range containing 0 (and above −1 for a stretch)"
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
         if let Some(g) = &self.grid {
             for (name, values) in [("s_x", &g.s_x), ("s_a", &g.s_a), ("s_y", &g.s_y)] {
                 if values.is_empty() {
@@ -368,7 +397,14 @@ impl Plan {
         let obj = value
             .as_object()
             .ok_or_else(|| err("-", "a plan is a JSON object".into()))?;
-        const FIELDS: [&str; 5] = ["ranges", "count_1d", "count_2d", "pairs", "grid"];
+        const FIELDS: [&str; 6] = [
+            "ranges",
+            "count_1d",
+            "count_2d",
+            "pairs",
+            "ranges_2d",
+            "grid",
+        ];
         for key in obj.keys() {
             if !FIELDS.contains(&key.as_str()) {
                 return Err(err(
@@ -412,6 +448,10 @@ impl Plan {
             count_1d: field(obj, "count_1d").map_err(|m| err("count_1d", m))?,
             count_2d: field(obj, "count_2d").map_err(|m| err("count_2d", m))?,
             pairs: field(obj, "pairs").map_err(|m| err("pairs", m))?,
+            ranges_2d: match obj.get("ranges_2d") {
+                None | Some(serde_json::Value::Null) => None,
+                Some(_) => Some(field(obj, "ranges_2d").map_err(|m| err("ranges_2d", m))?),
+            },
             grid: match obj.get("grid") {
                 None | Some(serde_json::Value::Null) => None,
                 Some(_) => Some(field(obj, "grid").map_err(|m| err("grid", m))?),
@@ -451,9 +491,14 @@ impl Plan {
         sample_range(k, lo, hi, self.count_1d)
     }
 
-    /// The values of strain `k` on a 2D grid axis.
-    pub fn axis_2d(&self, k: usize) -> Vec<f64> {
-        let [lo, hi] = self.ranges.get(k);
+    /// The values of side `side` (0: the first strain, 1: the second) of pair `p`'s grid axis: SAMPLERANGE over
+    /// the pair's own range when the plan has `ranges_2d`, else over the strain's range.
+    pub fn axis_2d(&self, p: usize, side: usize) -> Vec<f64> {
+        let k = self.pair_indices()[p][side];
+        let [lo, hi] = match &self.ranges_2d {
+            Some(r) => r[p][side],
+            None => self.ranges.get(k),
+        };
         sample_range(k, lo, hi, self.count_2d)
     }
 
@@ -486,9 +531,9 @@ impl Plan {
                 zs.push(z);
             }
         }
-        for [a, b] in self.pair_indices() {
-            let va = self.axis_2d(a);
-            let vb = self.axis_2d(b);
+        for (p, [a, b]) in self.pair_indices().into_iter().enumerate() {
+            let va = self.axis_2d(p, 0);
+            let vb = self.axis_2d(p, 1);
             for x in &va {
                 for y in &vb {
                     let mut z = [0.0; 5];
@@ -537,13 +582,13 @@ impl Plan {
             chains.push(Chain { steps });
         }
         let n = self.count_2d;
-        for (p, [a, b]) in self.pair_indices().into_iter().enumerate() {
+        for p in 0..self.pairs.len() {
             if n == 0 {
                 continue;
             }
             let base = 5 * self.count_1d + p * n * n;
-            let (i0, iup, idown) = rays(&self.axis_2d(a));
-            let (j0, jup, jdown) = rays(&self.axis_2d(b));
+            let (i0, iup, idown) = rays(&self.axis_2d(p, 0));
+            let (j0, jup, jdown) = rays(&self.axis_2d(p, 1));
             let at = |i: usize, j: usize| base + i * n + j;
             // the axis: column j0, two rays from (i0, j0)
             let mut steps = vec![Step {
@@ -636,6 +681,39 @@ mod tests {
         let mut bad = p.clone();
         bad.grid.as_mut().unwrap().s_a[0] = 1.0;
         assert!(bad.validate().unwrap_err().field == "grid.s_a");
+    }
+
+    #[test]
+    fn per_pair_2d_ranges() {
+        let mut p = Plan::reduced();
+        let base_hash = p.hash();
+        let mut r: Vec<[[f64; 2]; 2]> = p
+            .pairs
+            .iter()
+            .map(|[a, b]| {
+                let (ka, kb) = (strain_index(a).unwrap(), strain_index(b).unwrap());
+                [p.ranges.get(ka), p.ranges.get(kb)]
+            })
+            .collect();
+        r[0] = [[-0.1, 0.84], [-0.6, 0.6]];
+        p.ranges_2d = Some(r);
+        p.validate().unwrap();
+        assert_ne!(p.hash(), base_hash);
+        let s = p.samples();
+        let g0: Vec<&Sample> = s[150..250].iter().collect();
+        let min_sx = g0.iter().map(|s| s.z[0]).fold(f64::INFINITY, f64::min);
+        let max_sa = g0.iter().map(|s| s.z[1]).fold(f64::NEG_INFINITY, f64::max);
+        assert!((min_sx + 0.1).abs() < 1e-12 && (max_sa - 0.6).abs() < 1e-12);
+        // the other grids keep the strain ranges
+        assert_eq!(s[250].z[0], -0.6000000000000001);
+        assert_eq!(Plan::from_json(&p.canonical_json(), None).unwrap(), p);
+        // one entry per pair, each containing 0
+        let mut bad = p.clone();
+        bad.ranges_2d.as_mut().unwrap().pop();
+        assert_eq!(bad.validate().unwrap_err().field, "ranges_2d");
+        let mut bad = p.clone();
+        bad.ranges_2d.as_mut().unwrap()[3][1] = [10.0, 20.0];
+        assert_eq!(bad.validate().unwrap_err().field, "ranges_2d[3][1]");
     }
 
     #[test]
