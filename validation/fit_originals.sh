@@ -8,6 +8,7 @@
 #
 #   cargo build --release && validation/fit_originals.sh            # all five (about an hour on 2 cores)
 #   validation/fit_originals.sh basket satin                        # some of them
+#   PLAN=_1d validation/fit_originals.sh                            # the 1D ranges only (plans/<pattern>_1d.json)
 #
 # Resumable: rerunning skips finished samples.
 set -uo pipefail
@@ -15,6 +16,7 @@ cd "$(dirname "$0")/.."
 HYLC=${HYLC:-target/release/hylc}
 D=${HYLC_SHARED:-../shared}/data/hylc2020
 OUT=validation/fit
+PLAN=${PLAN:-}
 if [ ! -d "$D" ]; then
   echo "skipped: $D not found (set HYLC_SHARED)"; exit 0
 fi
@@ -27,9 +29,9 @@ for pat in "${PATTERNS[@]}"; do
   flags=""
   [ "$pat" = stockinette ] && flags=--stockinette-like
   echo "== $pat"
-  /usr/bin/time -f "sample wall time %e s" "$HYLC" sample "$D/patterns/$pat.pyp" --plan "validation/plans/$pat.json" \
-    --out "$OUT/$pat.jsonl"
+  /usr/bin/time -f "sample wall time %e s" "$HYLC" sample "$D/patterns/$pat.pyp" --plan "validation/plans/$pat$PLAN.json" \
+    --out "$OUT/$pat$PLAN.jsonl"
   rc=$?
   if [ $rc -ne 0 ] && [ $rc -ne 3 ]; then echo "sample failed ($rc)"; exit $rc; fi
-  "$HYLC" fit "$OUT/$pat.jsonl" --compare "$D/materials/$mat.json" $flags || exit $?
+  "$HYLC" fit "$OUT/$pat$PLAN.jsonl" --compare "$D/materials/$mat.json" $flags || exit $?
 done

@@ -156,8 +156,8 @@ pub struct FitReport {
     pub all: ModelError,
     pub holdout: Option<ModelError>,
     /// the 1D curves against another material ([`compare_1d`]), when asked for
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub compare_1d: Vec<RangeComparison>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compare_1d: Option<Comparison1D>,
 }
 
 /// The data one term was fitted to (for plots): normalised coordinates and Ψ̄ (NaN for failed samples).
@@ -455,7 +455,7 @@ pub fn fit_material(
         terms2d,
         all,
         holdout,
-        compare_1d: vec![],
+        compare_1d: None,
     };
 
     let mut meta = meta;
@@ -517,8 +517,23 @@ pub struct RangeComparison {
     /// the terms alone, f_k against theirs (each material's f₀ removed): the shape of the response without the
     /// energy of the zero-strain state
     pub term_rms_rel: f64,
+    /// the least-squares factor c minimising ‖c (f₀ + f_k)_ours − (f₀ + f_k)_theirs‖ on this range
+    pub scale: f64,
+    /// the fit error after multiplying ours by the common factor of all ranges ([`Comparison1D::common_scale`])
+    pub scaled_fit_rms_rel: f64,
     /// our f₀ + f_k and theirs at the two ends of the interval
     pub ends: [[f64; 2]; 2],
+}
+
+/// The 1D comparison of two materials.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Comparison1D {
+    pub ranges: Vec<RangeComparison>,
+    /// One factor c for all ranges, minimising Σ_k ‖c ours_k − theirs_k‖² / ‖theirs_k‖². Ψ̄ is exactly
+    /// proportional to a common factor on all yarn stiffnesses (Y, G, k_c: the equilibria do not change), so c
+    /// estimates the ratio of the other material's stiffness scale to ours, which the equilibrium calibration
+    /// cannot see.
+    pub common_scale: f64,
 }
 
 /// Compare the 1D curves f₀ + f_k of a fitted material with another material's (the original's) along the
@@ -529,7 +544,7 @@ pub fn compare_1d(
     plan: &Plan,
     records: &[Record],
     other: &Material,
-) -> Vec<RangeComparison> {
+) -> Comparison1D {
     let samples = plan.samples();
     let mut psi = vec![None; plan.len()];
     for r in records {
@@ -537,7 +552,9 @@ pub fn compare_1d(
             psi[r.index] = r.psi;
         }
     }
+    let rel = |num: f64, den: f64| (num / den.max(1e-300)).sqrt();
     let mut out = Vec::new();
+    let mut values: Vec<Vec<(f64, f64)>> = Vec::new();
     for k in 0..5 {
         let Some(term) = other.terms1d.iter().find(|t| t.k == k) else {
             continue;
@@ -545,10 +562,8 @@ pub fn compare_1d(
         let t = &term.spline.t;
         let sig = other.strain_scale[k];
         let interval = [t[0] / 0.95 * sig, t[t.len() - 1] / 0.95 * sig];
-        let (mut d2, mut o2, mut s2, mut so2, mut n) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0);
-        let (mut t2, mut to2) = (0.0f64, 0.0f64);
-        let mut ends = [[f64::NAN; 2]; 2];
-        let mut first = true;
+        let (mut s2, mut so2, mut t2, mut to2) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        let mut pts = Vec::new();
         for i in k * plan.count_1d..(k + 1) * plan.count_1d {
             let z = samples[i].z;
             if z[k] < interval[0] - 1e-12 || z[k] > interval[1] + 1e-12 {
@@ -556,32 +571,50 @@ pub fn compare_1d(
             }
             let z6 = strain6(&z);
             let (ours, theirs) = (fit.material.value(&z6), other.value(&z6));
-            if first {
-                ends[0] = [ours, theirs];
-                first = false;
-            }
-            ends[1] = [ours, theirs];
-            n += 1;
+            pts.push((ours, theirs));
             let (fo, ft) = (ours - fit.material.constant, theirs - other.constant);
             t2 += (fo - ft).powi(2);
             to2 += ft * ft;
-            d2 += (ours - theirs).powi(2);
-            o2 += theirs * theirs;
             if let Some(p) = psi[i].filter(|v| v.is_finite()) {
                 s2 += (p - theirs).powi(2);
                 so2 += theirs * theirs;
             }
         }
+        let d2: f64 = pts.iter().map(|(o, t)| (o - t).powi(2)).sum();
+        let o2: f64 = pts.iter().map(|(_, t)| t * t).sum();
+        let ot: f64 = pts.iter().map(|(o, t)| o * t).sum();
+        let oo: f64 = pts.iter().map(|(o, _)| o * o).sum();
         out.push(RangeComparison {
             k,
             strain: STRAIN_NAMES[k].to_string(),
-            n_points: n,
+            n_points: pts.len(),
             interval,
-            fit_rms_rel: (d2 / o2.max(1e-300)).sqrt(),
-            samples_rms_rel: (s2 / so2.max(1e-300)).sqrt(),
-            term_rms_rel: (t2 / to2.max(1e-300)).sqrt(),
-            ends,
+            fit_rms_rel: rel(d2, o2),
+            samples_rms_rel: rel(s2, so2),
+            term_rms_rel: rel(t2, to2),
+            scale: ot / oo.max(1e-300),
+            scaled_fit_rms_rel: f64::NAN,
+            ends: match (pts.first(), pts.last()) {
+                (Some(a), Some(b)) => [[a.0, a.1], [b.0, b.1]],
+                _ => [[f64::NAN; 2]; 2],
+            },
         });
+        values.push(pts);
     }
-    out
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for pts in &values {
+        let o2: f64 = pts.iter().map(|(_, t)| t * t).sum::<f64>().max(1e-300);
+        num += pts.iter().map(|(o, t)| o * t).sum::<f64>() / o2;
+        den += pts.iter().map(|(o, _)| o * o).sum::<f64>() / o2;
+    }
+    let c = num / den.max(1e-300);
+    for (r, pts) in out.iter_mut().zip(&values) {
+        let d2: f64 = pts.iter().map(|(o, t)| (c * o - t).powi(2)).sum();
+        let o2: f64 = pts.iter().map(|(_, t)| t * t).sum();
+        r.scaled_fit_rms_rel = rel(d2, o2);
+    }
+    Comparison1D {
+        ranges: out,
+        common_scale: c,
+    }
 }

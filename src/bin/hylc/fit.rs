@@ -150,7 +150,7 @@ pub fn fit(
     }
     if let Some(c) = &args.compare {
         let other = Material::load(c).map_err(|e| e.to_string())?;
-        fit.report.compare_1d = compare_1d(&fit, &plan, &records, &other);
+        fit.report.compare_1d = Some(compare_1d(&fit, &plan, &records, &other));
     }
     fit.material
         .save(out)
@@ -211,24 +211,25 @@ pub fn fit(
             ))
         );
     }
-    if !r.compare_1d.is_empty() {
+    if let Some(cmp) = &r.compare_1d {
         println!(
-            "1D curves f₀ + f_k against {} (relative RMS over its sampled range):",
-            args.compare
-                .as_ref()
-                .map_or(String::new(), |p| p.display().to_string())
+            "1D curves f₀ + f_k against {} (relative RMS over its sampled range; common stiffness factor c = {:.4}):",
+            args.compare.as_ref().map_or(String::new(), |p| p.display().to_string()),
+            cmp.common_scale
         );
-        println!("strain   points  interval             our fit  our samples  f_k alone");
-        for c in &r.compare_1d {
+        println!("strain   points  interval             our fit  our samples  f_k alone  best c   c × our fit");
+        for c in &cmp.ranges {
             println!(
-                "{:<8} {:>6}  [{:>8.3}, {:>8.3}]  {:>7.3}  {:>11.3}  {:>9.3}",
+                "{:<8} {:>6}  [{:>8.3}, {:>8.3}]  {:>7.3}  {:>11.3}  {:>9.3}  {:>6.4}  {:>11.3}",
                 c.strain,
                 c.n_points,
                 c.interval[0],
                 c.interval[1],
                 c.fit_rms_rel,
                 c.samples_rms_rel,
-                c.term_rms_rel
+                c.term_rms_rel,
+                c.scale,
+                c.scaled_fit_rms_rel
             );
         }
     }
