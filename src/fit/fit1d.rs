@@ -19,7 +19,7 @@
 //! slightly off the knot).
 
 use super::mls::{Mls1D, DEFAULT_BANDWIDTH_FACTOR};
-use super::symlog::{symexp, symlog};
+use super::symlog::{symexp, symlog_samples};
 use super::FitError;
 use crate::material::Hermite1D;
 
@@ -156,13 +156,7 @@ pub fn fit1d_with_stress(
     let n_excluded = x.len() - xs.len();
 
     // step 1: g = symexp ∘ MLS ∘ symlog
-    let psi_max = ys.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let eps = if psi_max > 0.0 {
-        opts.eps_rel * psi_max
-    } else {
-        1.0
-    };
-    let logs: Vec<f64> = ys.iter().map(|&v| symlog(v, eps)).collect();
+    let (eps, psi_max, logs) = symlog_samples(&ys, opts.eps_rel);
     let mls = Mls1D::new(&xs, &logs, opts.bandwidth_factor)?;
     let g = |u: f64| {
         let w = if opts.symmetric {

@@ -40,7 +40,7 @@
 
 use super::fit1d::MinimumAt;
 use super::mls::{Mls2D, DEFAULT_BANDWIDTH_FACTOR};
-use super::symlog::{symexp, symlog};
+use super::symlog::{symexp, symlog_samples};
 use super::FitError;
 use crate::material::Hermite2D;
 
@@ -280,13 +280,7 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
     let n_excluded = psi.len() - fs.len();
 
     // step 1
-    let psi_max = fs.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let eps = if psi_max > 0.0 {
-        opts.eps_rel * psi_max
-    } else {
-        1.0
-    };
-    let logs: Vec<f64> = fs.iter().map(|&v| symlog(v, eps)).collect();
+    let (eps, psi_max, logs) = symlog_samples(&fs, opts.eps_rel);
     let mls = Mls2D::new(&xs, &ys, &logs, opts.bandwidth_factor)?;
     let [su, sv] = opts.symmetric;
     let g = |u: f64, v: f64| symexp(mls.eval_symmetric(u, v, su, sv), eps);
