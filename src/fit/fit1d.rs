@@ -156,7 +156,7 @@ pub fn fit1d_with_stress(
     let n_excluded = x.len() - xs.len();
 
     // step 1: g = symexp ∘ MLS ∘ symlog
-    let (eps, psi_max, logs) = symlog_samples(&ys, opts.eps_rel);
+    let (eps, logs) = symlog_samples(&ys, opts.eps_rel);
     let mls = Mls1D::new(&xs, &logs, opts.bandwidth_factor)?;
     let g = |u: f64| {
         let w = if opts.symmetric {
@@ -273,22 +273,15 @@ pub fn fit1d_with_stress(
     let spline = Hermite1D::new(t, p, m);
 
     // report
-    let (mut se, mut sp, mut emax) = (0.0f64, 0.0f64, 0.0f64);
+    let mut err = super::RelError::default();
     for (&xv, &yv) in xs.iter().zip(&ys) {
-        let e = spline.eval2(xv)[0] + offset - yv;
-        se += e * e;
-        sp += yv * yv;
-        emax = emax.max(e.abs());
+        err.add(spline.eval2(xv)[0] + offset, yv);
     }
     let report = Fit1DReport {
         n_samples: xs.len(),
         n_excluded,
-        rms_rel: if sp > 0.0 {
-            (se / sp).sqrt()
-        } else {
-            se.sqrt()
-        },
-        max_rel: if psi_max > 0.0 { emax / psi_max } else { emax },
+        rms_rel: err.rms_rel(),
+        max_rel: err.max_rel(),
         i_min,
     };
     Ok(Fit1D {

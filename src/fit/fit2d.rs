@@ -280,7 +280,7 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
     let n_excluded = psi.len() - fs.len();
 
     // step 1
-    let (eps, psi_max, logs) = symlog_samples(&fs, opts.eps_rel);
+    let (eps, logs) = symlog_samples(&fs, opts.eps_rel);
     let mls = Mls2D::new(&xs, &ys, &logs, opts.bandwidth_factor)?;
     let [su, sv] = opts.symmetric;
     let g = |u: f64, v: f64| symexp(mls.eval_symmetric(u, v, su, sv), eps);
@@ -491,12 +491,9 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
     let full = grid.spline();
 
     // report on the unconverted spline
-    let (mut se, mut sp, mut emax) = (0.0f64, 0.0f64, 0.0f64);
+    let mut err = super::RelError::default();
     for ((&u, &v), &f) in xs.iter().zip(&ys).zip(&fs) {
-        let e = full.eval2(u, v)[0] - f;
-        se += e * e;
-        sp += f * f;
-        emax = emax.max(e.abs());
+        err.add(full.eval2(u, v)[0], f);
     }
 
     // step 6: residual about the knots u = 0 (i0 = i_min) and v = 0 (j0)
@@ -548,12 +545,8 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
     let report = Fit2DReport {
         n_samples: fs.len(),
         n_excluded,
-        rms_rel: if sp > 0.0 {
-            (se / sp).sqrt()
-        } else {
-            se.sqrt()
-        },
-        max_rel: if psi_max > 0.0 { emax / psi_max } else { emax },
+        rms_rel: err.rms_rel(),
+        max_rel: err.max_rel(),
         i_min,
         j_min,
         twist_rounds,

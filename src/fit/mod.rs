@@ -15,7 +15,7 @@ pub use fit1d::{
 };
 pub use fit2d::{fit2d, Fit2D, Fit2DOptions, Fit2DReport};
 pub use mls::{Mls1D, Mls2D};
-pub use model::{fit_material, holdout_error, FitOptions, FitReport, MaterialFit, ModelError};
+pub use model::{fit_material, model_error, FitOptions, FitReport, MaterialFit, ModelError};
 
 use std::fmt;
 
@@ -51,6 +51,54 @@ impl fmt::Display for FitError {
 }
 
 impl std::error::Error for FitError {}
+
+/// Relative errors of fitted values against data: √(Σ e²)/√(Σ y²) and max |e| / max |y| (absolute when the data
+/// are all 0), with the index of the largest |e|.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct RelError {
+    se: f64,
+    sy: f64,
+    emax: f64,
+    ymax: f64,
+    worst: Option<usize>,
+    n: usize,
+}
+
+impl RelError {
+    /// Add one pair (fitted value, data value).
+    pub(crate) fn add(&mut self, fit: f64, data: f64) {
+        let e = fit - data;
+        self.se += e * e;
+        self.sy += data * data;
+        self.ymax = self.ymax.max(data.abs());
+        if e.abs() >= self.emax {
+            self.emax = e.abs();
+            self.worst = Some(self.n);
+        }
+        self.n += 1;
+    }
+
+    pub(crate) fn rms_rel(&self) -> f64 {
+        if self.sy > 0.0 {
+            (self.se / self.sy).sqrt()
+        } else {
+            self.se.sqrt()
+        }
+    }
+
+    pub(crate) fn max_rel(&self) -> f64 {
+        if self.ymax > 0.0 {
+            self.emax / self.ymax
+        } else {
+            self.emax
+        }
+    }
+
+    /// The position (in order of [`RelError::add`]) of the largest |e|.
+    pub(crate) fn worst(&self) -> Option<usize> {
+        self.worst
+    }
+}
 
 /// The option checks FIT1D and FIT2D share: ε, pˣ_min and the finite-difference step.
 fn check_common(eps_rel: f64, min_slope: f64, fd_step: f64) -> Result<(), FitError> {

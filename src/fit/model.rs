@@ -13,7 +13,7 @@
 //!   zero-compressed, a stretch axis of any other pair is zero-compressed, an s_a axis is symmetrised, and the
 //!   minimum of a bending axis is its argmin. The pair's strains are ordered k < l in the material.
 //! - Errors of the whole model ψ against every sample it was fitted to (1D ranges and 2D planes) and, optionally,
-//!   against held-out samples ([`holdout_error`], e.g. the in-plane grid of [`crate::sample::plan::InPlaneGrid`]).
+//!   against held-out samples ([`model_error`] on any sample file, e.g. the in-plane grid of [`crate::sample::plan::InPlaneGrid`]).
 //!
 //! The exported material carries a `meta` block (pattern, yarn parameters, plan hash, fit errors) and the
 //! original's `"strain shift": [1, 0, 1, 0, 0]`, so the original macro-scale code reads it too.
@@ -187,36 +187,25 @@ pub fn model_error<'a>(
     material: &Material,
     records: impl IntoIterator<Item = &'a Record>,
 ) -> ModelError {
-    let mut e = ModelError::default();
-    let (mut se, mut sp, mut emax, mut pmax) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let mut n_excluded = 0;
+    let mut err = super::RelError::default();
+    let mut compared = Vec::new();
     for r in records {
         let Some(psi) = r.psi.filter(|v| v.is_finite()) else {
-            e.n_excluded += 1;
+            n_excluded += 1;
             continue;
         };
         let m = material.value(&strain6(&r.z));
-        let d = m - psi;
-        e.n_samples += 1;
-        se += d * d;
-        sp += psi * psi;
-        pmax = pmax.max(psi.abs());
-        if d.abs() >= emax {
-            emax = d.abs();
-            e.worst = Some((r.z, psi, m));
-        }
+        err.add(m, psi);
+        compared.push((r.z, psi, m));
     }
-    e.rms_rel = if sp > 0.0 {
-        (se / sp).sqrt()
-    } else {
-        se.sqrt()
-    };
-    e.max_rel = if pmax > 0.0 { emax / pmax } else { emax };
-    e
-}
-
-/// The model's error on held-out samples (any sample file, e.g. a run of [`Plan::holdout`]).
-pub fn holdout_error(material: &Material, records: &[Record]) -> ModelError {
-    model_error(material, records)
+    ModelError {
+        n_samples: compared.len(),
+        n_excluded,
+        rms_rel: err.rms_rel(),
+        max_rel: err.max_rel(),
+        worst: err.worst().map(|i| compared[i]),
+    }
 }
 
 /// Fit a material (Algorithm C5) to the records of `plan` (other records are ignored; a record whose id does not

@@ -15,15 +15,15 @@ pub fn symexp(w: f64, eps: f64) -> f64 {
 }
 
 /// Step 1's transform of the sample values: ε = `eps_rel` · max|Ψ| (1 when all Ψ are 0) and symlog(Ψ, ε) of
-/// each. Returns (ε, max|Ψ|, the transformed values).
-pub fn symlog_samples(psi: &[f64], eps_rel: f64) -> (f64, f64, Vec<f64>) {
+/// each. Returns (ε, the transformed values).
+pub fn symlog_samples(psi: &[f64], eps_rel: f64) -> (f64, Vec<f64>) {
     let psi_max = psi.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let eps = if psi_max > 0.0 {
         eps_rel * psi_max
     } else {
         1.0
     };
-    (eps, psi_max, psi.iter().map(|&v| symlog(v, eps)).collect())
+    (eps, psi.iter().map(|&v| symlog(v, eps)).collect())
 }
 
 #[cfg(test)]

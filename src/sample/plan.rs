@@ -253,6 +253,40 @@ fn push_ray(steps: &mut Vec<Step>, start: usize, samples: impl IntoIterator<Item
     }
 }
 
+/// A continuation chain over a 2D tensor grid (`at(i, j)` = sample index; `first`, `second` = [`rays`] of the two
+/// axes, `n_first` values along the first): the line j = j0 as two rays from (i0, j0), which starts from the
+/// reference state, then every line i, in index order, as two rays in j from its point on that line.
+fn grid_chain(
+    first: &(usize, Vec<usize>, Vec<usize>),
+    second: &(usize, Vec<usize>, Vec<usize>),
+    n_first: usize,
+    at: impl Fn(usize, usize) -> usize,
+) -> Vec<Step> {
+    let (i0, iup, idown) = first;
+    let (j0, jup, jdown) = second;
+    let mut steps = vec![Step {
+        sample: at(*i0, *j0),
+        from: None,
+    }];
+    let mut line_step = vec![0usize; n_first];
+    for ray in [iup, idown] {
+        let mut from = 0;
+        for &i in ray {
+            steps.push(Step {
+                sample: at(i, *j0),
+                from: Some(from),
+            });
+            from = steps.len() - 1;
+            line_step[i] = from;
+        }
+    }
+    for i in 0..n_first {
+        push_ray(&mut steps, line_step[i], jup.iter().map(|&j| at(i, j)));
+        push_ray(&mut steps, line_step[i], jdown.iter().map(|&j| at(i, j)));
+    }
+    steps
+}
+
 impl Plan {
     /// A reduced plan for quick runs and tests: 30 samples per 1D range, 10×10 grids, default ranges and pairs.
     pub fn reduced() -> Self {
@@ -587,31 +621,13 @@ impl Plan {
                 continue;
             }
             let base = 5 * self.count_1d + p * n * n;
-            let (i0, iup, idown) = rays(&self.axis_2d(p, 0));
-            let (j0, jup, jdown) = rays(&self.axis_2d(p, 1));
             let at = |i: usize, j: usize| base + i * n + j;
-            // the axis: column j0, two rays from (i0, j0)
-            let mut steps = vec![Step {
-                sample: at(i0, j0),
-                from: None,
-            }];
-            let mut axis_step = vec![0usize; n];
-            for ray in [&iup, &idown] {
-                let mut from = 0;
-                for &i in ray {
-                    steps.push(Step {
-                        sample: at(i, j0),
-                        from: Some(from),
-                    });
-                    from = steps.len() - 1;
-                    axis_step[i] = from;
-                }
-            }
-            // the rows, in plan order, each as two rays from its axis point
-            for i in 0..n {
-                push_ray(&mut steps, axis_step[i], jup.iter().map(|&j| at(i, j)));
-                push_ray(&mut steps, axis_step[i], jdown.iter().map(|&j| at(i, j)));
-            }
+            let steps = grid_chain(
+                &rays(&self.axis_2d(p, 0)),
+                &rays(&self.axis_2d(p, 1)),
+                n,
+                at,
+            );
             chains.push(Chain { steps });
         }
         // the in-plane grid: one chain per s_x value, cold at (s_x, s_a ≈ 0, s_y ≈ 0), then the s_a line as two
@@ -619,30 +635,10 @@ impl Plan {
         if let Some(g) = &self.grid {
             let base = self.grid_start();
             let (na, ny) = (g.s_a.len(), g.s_y.len());
-            let (a0, aup, adown) = rays(&g.s_a);
-            let (y0, yup, ydown) = rays(&g.s_y);
+            let (sa, sy) = (rays(&g.s_a), rays(&g.s_y));
             for i in 0..g.s_x.len() {
                 let at = |a: usize, y: usize| base + (i * na + a) * ny + y;
-                let mut steps = vec![Step {
-                    sample: at(a0, y0),
-                    from: None,
-                }];
-                let mut line_step = vec![0usize; na];
-                for ray in [&aup, &adown] {
-                    let mut from = 0;
-                    for &a in ray {
-                        steps.push(Step {
-                            sample: at(a, y0),
-                            from: Some(from),
-                        });
-                        from = steps.len() - 1;
-                        line_step[a] = from;
-                    }
-                }
-                for a in 0..na {
-                    push_ray(&mut steps, line_step[a], yup.iter().map(|&y| at(a, y)));
-                    push_ray(&mut steps, line_step[a], ydown.iter().map(|&y| at(a, y)));
-                }
+                let steps = grid_chain(&sa, &sy, na, at);
                 chains.push(Chain { steps });
             }
         }

@@ -2,7 +2,7 @@
 //! `hylc::fit::model`), with the JSON fit report and PNG plots.
 
 use crate::sample::{load_plan, meta_path};
-use hylc::fit::model::{compare_1d, fit_material, holdout_error, FitOptions};
+use hylc::fit::model::{compare_1d, fit_material, model_error, FitOptions};
 use hylc::fit::plot::plot_material_fit;
 use hylc::fit::SlopeSource;
 use hylc::material::Material;
@@ -138,7 +138,7 @@ pub fn fit(
         if hr.is_empty() {
             return Err(format!("{}: no samples", h.display()));
         }
-        let e = holdout_error(&fit.material, &hr);
+        let e = model_error(&fit.material, &hr);
         if let Some(serde_json::Value::Object(m)) = fit.material.extra.get_mut("meta") {
             m.insert(
                 "holdout".into(),
