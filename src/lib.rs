@@ -14,6 +14,7 @@ pub mod rod;
 pub mod sample;
 pub mod shell;
 pub mod tile;
+pub mod validate;
 
 use std::path::PathBuf;
 

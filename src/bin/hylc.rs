@@ -8,10 +8,14 @@ mod fit;
 mod micro;
 #[path = "hylc/micro_grid.rs"]
 mod micro_grid;
+#[path = "hylc/pipeline.rs"]
+mod pipeline;
 #[path = "hylc/sample.rs"]
 mod sample;
 #[path = "hylc/simulate.rs"]
 mod simulate;
+#[path = "hylc/validate.rs"]
+mod validate;
 
 use clap::{Parser, Subcommand};
 use hylc::diff::{format_table, run_all, CheckConfig};
@@ -35,9 +39,59 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// The main job. Until the end-to-end pipeline lands: the material demo on the embedded default material
-    /// (writes it as JSON, evaluates ψ, ∇ψ, ∇²ψ along stretch, shear and bending sweeps, checks its derivatives).
+    /// The main job end to end: generate a stockinette (or the given patterns), compute its reference state,
+    /// run the quick sampling plan and a 27-point held-out grid, fit the material, drape a cloth with it; prints a
+    /// summary and writes everything to the output folder. A rerun resumes (finished samples are kept).
     Run {
+        /// output folder
+        #[arg(long, default_value = "out/run")]
+        out: PathBuf,
+        /// patterns: generated kinds (stockinette, plain, twill, satin, basket) or .pyp files, comma-separated
+        #[arg(long, default_value = "stockinette", value_delimiter = ',')]
+        pattern: Vec<String>,
+        /// construction of .pyp files (knitted or woven); generated kinds know theirs
+        #[arg(long)]
+        construction: Option<String>,
+        /// sampling plan: quick (474 samples), reduced (1 050), default (23 250) or a plan file
+        #[arg(long, default_value = "quick")]
+        plan: String,
+        /// the cloth scene (a built-in or a scene file)
+        #[arg(long, default_value = "drape-x")]
+        scene: String,
+        /// edge length (m) of the scene's rectangle mesh (default: 1 cm, 1 800 triangles)
+        #[arg(long, default_value_t = 0.01)]
+        edge: f64,
+        /// simulated time (s) instead of the scene's
+        #[arg(long)]
+        duration: Option<f64>,
+        /// time step of the cloth simulation (s); 1/240 by default: a knit's rest curl makes the cloth crumple at
+        /// the mesh scale, and at the scenes' 1/60 Newton no longer converges
+        #[arg(long, default_value_t = 1.0 / 240.0)]
+        dt: f64,
+        /// delete the output folder first instead of resuming
+        #[arg(long)]
+        fresh: bool,
+    },
+    /// The validation items of 06-verification.md (section 3) against ../shared: conformance with the original
+    /// code, the original patterns as equilibria, the micro solver against the original displacements, the fitted
+    /// materials against the original ones; writes the results table (skips when ../shared is absent).
+    Validate {
+        /// the results table (Markdown)
+        #[arg(long, default_value = "validation/results.md")]
+        write: PathBuf,
+        /// also put the table into this README between `<!-- validate:begin -->` and `<!-- validate:end -->`
+        #[arg(long)]
+        readme: Option<PathBuf>,
+        /// micro-grid points per pattern (the first N of the continuation order)
+        #[arg(long, default_value_t = 61)]
+        grid_limit: usize,
+        /// all 729 micro-grid points per pattern (about 40 min on 2 cores)
+        #[arg(long)]
+        full: bool,
+    },
+    /// The material demo on the embedded default material: writes it as JSON, evaluates ψ, ∇ψ, ∇²ψ along
+    /// stretch, shear and bending sweeps, times the fast path and checks its derivatives.
+    MaterialDemo {
         /// output folder
         #[arg(long, default_value = "out")]
         out: PathBuf,
@@ -145,6 +199,9 @@ enum Command {
         /// print one line per Newton step to stderr
         #[arg(long)]
         trace: bool,
+        /// Gauss points per segment of the contact quadrature (default: the calibrated yarn's)
+        #[arg(long)]
+        quadrature: Option<usize>,
     },
     /// Run a sampling plan on a pattern (warm-started chains in parallel), appending to a JSON-lines sample
     /// file; finished samples are skipped, so an interrupted run resumes where it stopped.
@@ -182,6 +239,22 @@ enum Command {
         out: PathBuf,
         /// input sample files
         inputs: Vec<PathBuf>,
+    },
+    /// Write a sampling plan covering only the strains one or more macro runs visited (their `log.jsonl`), plus
+    /// a margin, at the sample spacing of a base plan ("model only what a scene requires").
+    ScenePlan {
+        /// `log.jsonl` files of `hylc simulate` runs
+        #[arg(required = true)]
+        logs: Vec<PathBuf>,
+        /// plan file to write
+        #[arg(long)]
+        write: PathBuf,
+        /// base plan whose ranges clip and whose spacing is kept: default, reduced, quick or a plan file
+        #[arg(long, default_value = "default")]
+        base: String,
+        /// margin added on each side, as a fraction of each visited interval
+        #[arg(long, default_value_t = 0.1)]
+        margin: f64,
     },
     /// Write the default sampling plan (or the reduced one) as JSON.
     Plan {
@@ -341,6 +414,9 @@ enum Command {
         /// simulated time (s) instead of the scene's
         #[arg(long)]
         duration: Option<f64>,
+        /// time step (s) instead of the scene's
+        #[arg(long)]
+        dt: Option<f64>,
         /// edge length (m) of a rectangle mesh instead of the scene's
         #[arg(long)]
         edge: Option<f64>,
@@ -368,7 +444,52 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run { out } => run_demo(&out),
+        Command::Run {
+            out,
+            pattern,
+            construction,
+            plan,
+            scene,
+            edge,
+            duration,
+            dt,
+            fresh,
+        } => pipeline::run(&pipeline::RunArgs {
+            out,
+            patterns: pattern,
+            plan,
+            scene,
+            edge: Some(edge),
+            duration,
+            dt,
+            fresh,
+            construction,
+        })
+        .map(|ok| {
+            if ok {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(3)
+            }
+        }),
+        Command::MaterialDemo { out } => run_demo(&out),
+        Command::Validate {
+            write,
+            readme,
+            grid_limit,
+            full,
+        } => validate::run(&validate::ValidateArgs {
+            write,
+            readme,
+            grid_limit: (!full).then_some(grid_limit),
+        })
+        .map(|ok| {
+            if ok {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            }
+        }),
         Command::CheckDerivatives {
             cases,
             seed,
@@ -431,6 +552,12 @@ fn main() -> ExitCode {
                 }
             })
         }
+        Command::ScenePlan {
+            logs,
+            write,
+            base,
+            margin,
+        } => sample::scene_plan_cmd(&logs, &write, &base, margin).map(|_| ExitCode::SUCCESS),
         Command::Merge { out, inputs } => {
             sample::merge_cmd(&out, &inputs).map(|_| ExitCode::SUCCESS)
         }
@@ -507,6 +634,7 @@ fn main() -> ExitCode {
             obj,
             json,
             trace,
+            quadrature,
         } => {
             let options = hylc::micro::SolverOptions {
                 trace,
@@ -526,6 +654,7 @@ fn main() -> ExitCode {
                 options,
                 obj.as_deref(),
                 json,
+                quadrature,
             )
             .map(|ok| {
                 if ok {
@@ -604,6 +733,7 @@ fn main() -> ExitCode {
             out,
             material,
             duration,
+            dt,
             edge,
             psd,
             no_bending,
@@ -617,6 +747,7 @@ fn main() -> ExitCode {
             &simulate::Overrides {
                 material,
                 duration,
+                dt,
                 edge,
                 psd,
                 no_bending,

@@ -13,10 +13,14 @@
 //!    linear continuation keeps rising away from the minimum.
 //! 6. Residual: p ← p − f(0); the removed constant is returned as [`Fit1D::offset`] (it belongs to f₀).
 //!
-//! The slope at i_min itself is only limited by step 4 on the side its sign points to; the cell on the other side
-//! then has slopes of opposite signs at its ends, and a cubic Hermite cell whose end slopes are (−, +) has a
-//! quadratic derivative with exactly one root in the cell, so the spline stays quasi-convex (its minimum may sit
-//! slightly off the knot).
+//! The slope at i_min: for in-plane strains (i_min the knot at 0) it is set to 0, as in the original materials,
+//! so that f_k(0) = 0 is the minimum and the rest state z = 0 is an equilibrium of ψ along every in-plane axis.
+//! Finite differences of g across a kink of Ψ̄ at 0 (a knit is far softer in compression than in tension) give a
+//! slope there of the tension side's sign, and the cell on the compression side would dip below f₀ (by 7 % of f₀
+//! on the generated stockinette with 30 samples). For bending (i_min = argmin p) the slope is only limited by
+//! step 4 on the side its sign points to; the cell on the other side then has slopes of opposite signs at its
+//! ends, and a cubic Hermite cell whose end slopes are (−, +) has a quadratic derivative with exactly one root in
+//! the cell, so the spline stays quasi-convex (its minimum may sit slightly off the knot).
 
 use super::mls::{Mls1D, DEFAULT_BANDWIDTH_FACTOR};
 use super::symlog::{symexp, symlog_samples};
@@ -235,6 +239,9 @@ pub fn fit1d_with_stress(
         MinimumAt::Argmin => (0..n).fold(0, |b, i| if p[i] < p[b] { i } else { b }),
     };
     let pmin = opts.min_slope;
+    if opts.minimum == MinimumAt::Zero {
+        m[i_min] = 0.0;
+    }
     for i in i_min + 1..n {
         p[i] = p[i].max(p[i - 1] + (t[i] - t[i - 1]) * pmin);
         m[i] = m[i].max(pmin);

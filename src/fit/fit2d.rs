@@ -1,4 +1,4 @@
-//! FIT2D (`04-sampling-fitting.md`, "Fitting (C5, C6, C7)", FIT2D steps 1–7): one 2D term f_kl of the material
+//! FIT2D (`04-sampling-fitting.md`, "Fitting (C5, C6, C7)", FIT2D steps 1–7, and a step 8 of ours): one 2D term f_kl of the material
 //! from samples (X, Y, Ψ) of its 2D grid (X, Y already normalised by the strain scales).
 //!
 //! 1. g(u, v) = symexp(MLS(u, v | X, Y, symlog Ψ)) with a 2D local-quadratic MLS ([`Mls2D`]), symmetrised in the
@@ -34,6 +34,13 @@
 //!    coordinate ≤ 0 gets p = pˣ = pʸ = pˣʸ = 0. Including the knot at 0 (where p and the along-axis slope are
 //!    already 0) makes r vanish on the whole compressed half-plane, not only at its knots; the original keeps a
 //!    non-zero twist there.
+//! 8. Bounded extrapolation (our addition): the residual's slope across the boundary of the knot box is set to 0
+//!    (pˣ on the first and last knot column, pʸ on the first and last row), so r continues as a constant beyond
+//!    the sampled box and only the 1D terms, which rise outward, extrapolate. Without it the linear continuation
+//!    of r, the difference of two fits' boundary slopes, can fall faster than the 1D terms rise: on the generated
+//!    stockinette with the quick plan ψ reached −186 J/m² at (s_x, s_y, II₀₀) = (1.95, −0.5, −1848 m⁻¹), and a
+//!    drape fell into that well. The changed slopes only reshape the boundary patches, which the report's errors
+//!    include.
 //!
 //! The unconverted spline f of step 5 is returned too ([`Fit2D::full`]): its errors against the samples are the
 //! fit's own quality; the material uses the residual.
@@ -539,6 +546,22 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
                     r.muv[k] = 0.0;
                 }
             }
+        }
+    }
+
+    // step 8: the residual stays constant beyond the knot box
+    for j in 0..nv {
+        for i in [0, nu - 1] {
+            let k = r.at(i, j);
+            r.mu[k] = 0.0;
+            r.muv[k] = 0.0;
+        }
+    }
+    for i in 0..nu {
+        for j in [0, nv - 1] {
+            let k = r.at(i, j);
+            r.mv[k] = 0.0;
+            r.muv[k] = 0.0;
         }
     }
 

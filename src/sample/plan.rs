@@ -297,6 +297,16 @@ impl Plan {
         }
     }
 
+    /// The plan of `hylc run`, the end-to-end job: 30 samples per 1D range and 6×6 grids (150 + 9 · 36 = 474
+    /// samples), default ranges and pairs, so that the whole job stays within minutes on 2 cores.
+    pub fn quick() -> Self {
+        Plan {
+            count_1d: 30,
+            count_2d: 6,
+            ..Plan::default()
+        }
+    }
+
     /// The held-out plan: only the in-plane grid of [`InPlaneGrid::original`] (729 samples, no 1D ranges or
     /// 2D grids).
     pub fn holdout() -> Self {

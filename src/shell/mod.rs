@@ -16,6 +16,7 @@ pub mod assemble;
 pub mod checks;
 pub mod element;
 pub mod mesh;
+pub mod render;
 pub mod scene;
 pub mod solver;
 

@@ -2,7 +2,7 @@
 //! `hylc::fit::model`), with the JSON fit report and PNG plots.
 
 use crate::sample::{load_plan, meta_path};
-use hylc::fit::model::{compare_1d, fit_material, model_error, FitOptions};
+use hylc::fit::model::{compare_1d, fit_material, model_error, FitOptions, FitReport};
 use hylc::fit::plot::plot_material_fit;
 use hylc::fit::SlopeSource;
 use hylc::material::Material;
@@ -83,7 +83,7 @@ pub fn fit(
     report: &Path,
     plots: &Path,
     args: FitArgs,
-) -> Result<(), String> {
+) -> Result<FitReport, String> {
     let t0 = Instant::now();
     let records = read_samples(samples, false)?;
     if records.is_empty() {
@@ -241,5 +241,5 @@ pub fn fit(
         }
     }
     println!("fit time {:.2} s", t0.elapsed().as_secs_f64());
-    Ok(())
+    Ok(fit.report)
 }

@@ -80,9 +80,17 @@ pub fn solve(
     options: SolverOptions,
     obj: Option<&Path>,
     json_out: bool,
+    quadrature: Option<usize>,
 ) -> Result<bool, String> {
     let p = load_pattern(pattern)?;
-    let problem = MicroProblem::new(p, &YarnMaterial::default(), options);
+    let mut yarn = YarnMaterial::default();
+    if let Some(q) = quadrature {
+        if q == 0 {
+            return Err("--quadrature: expected at least 1 point per segment".into());
+        }
+        yarn.contact_quadrature = q;
+    }
+    let problem = MicroProblem::new(p, &yarn, options);
     let strains: Vec<MacroStrain> = if z.is_empty() {
         vec![MacroStrain::ZERO]
     } else {

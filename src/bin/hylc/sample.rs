@@ -13,6 +13,7 @@ pub fn load_plan(arg: &str) -> Result<Plan, String> {
     match arg {
         "default" => Ok(Plan::default()),
         "reduced" => Ok(Plan::reduced()),
+        "quick" => Ok(Plan::quick()),
         "holdout" => Ok(Plan::holdout()),
         _ => Plan::load(Path::new(arg)).map_err(|e| e.to_string()),
     }
@@ -25,7 +26,12 @@ pub fn meta_path(samples: &Path) -> PathBuf {
 
 /// Write the sidecar of a sample file: the plan, the pattern (its `.pyp` text), the yarn parameters, the solver
 /// settings, the problem hash and the pattern's areal density, which `hylc fit` reads.
-fn write_meta(out: &Path, arg: &str, plan: &Plan, problem: &MicroProblem) -> Result<(), String> {
+pub fn write_meta(
+    out: &Path,
+    arg: &str,
+    plan: &Plan,
+    problem: &MicroProblem,
+) -> Result<(), String> {
     let m = &problem.material;
     let pyp = problem.pattern.to_pyp_string();
     let meta = serde_json::json!({
@@ -130,6 +136,62 @@ pub fn plan_cmd(write: &Path, reduced: bool, holdout: bool) -> Result<(), String
         plan.count_2d,
         plan.count_2d,
         plan.pairs.len()
+    );
+    Ok(())
+}
+
+/// `hylc scene-plan LOG... --write PLAN [--base B] [--margin M]`.
+pub fn scene_plan_cmd(
+    logs: &[PathBuf],
+    write: &Path,
+    base: &str,
+    margin: f64,
+) -> Result<(), String> {
+    use hylc::sample::scene::{scene_plan, StrainExtent};
+    if !(margin.is_finite() && margin >= 0.0) {
+        return Err(format!("--margin {margin}: expected a finite fraction ≥ 0"));
+    }
+    let base_plan = load_plan(base)?;
+    let mut ext = StrainExtent::empty();
+    for l in logs {
+        StrainExtent::read_log(l, &mut ext)?;
+    }
+    let (plan, r) = scene_plan(&base_plan, &ext, margin);
+    plan.validate().map_err(|e| format!("scene plan: {e}"))?;
+    let text = serde_json::to_string_pretty(&plan).map_err(|e| e.to_string())?;
+    std::fs::write(write, text + "\n").map_err(|e| format!("{}: {e}", write.display()))?;
+    println!(
+        "{} steps from {} log(s); margin {margin}; base plan {base} ({} samples)",
+        ext.steps,
+        logs.len(),
+        r.base_samples
+    );
+    println!(
+        "strain   visited                   plan range                share of base spacing axis"
+    );
+    for k in 0..5 {
+        println!(
+            "{:<8} [{:>9.4}, {:>9.4}]   [{:>9.4}, {:>9.4}]   {:>5.1} %",
+            hylc::micro::strain::STRAIN_NAMES[k],
+            r.visited[k][0],
+            r.visited[k][1],
+            r.ranges[k][0],
+            r.ranges[k][1],
+            100.0 * r.fraction[k]
+        );
+    }
+    println!(
+        "{}: plan {:016x}, {} samples ({} per 1D range, {}×{} grids on {} pairs): {} fewer solves than the base \
+         plan ({:.1} % of it)",
+        write.display(),
+        plan.hash(),
+        plan.len(),
+        plan.count_1d,
+        plan.count_2d,
+        plan.count_2d,
+        plan.pairs.len(),
+        r.base_samples - r.samples,
+        100.0 * r.samples as f64 / r.base_samples.max(1) as f64
     );
     Ok(())
 }

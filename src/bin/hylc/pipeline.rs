@@ -1,0 +1,380 @@
+//! `hylc run`: the main job end to end (`../shared/design/01-architecture.md`, "Command line"; the pipeline of
+//! `../shared/seed/hylc_pseudocode.txt`, C1 → C4 → C5–C7 → C8). For each pattern: generate it, compute its
+//! reference state (C1), run the quick sampling plan and a small held-out in-plane grid (C4), fit the material
+//! (C5–C7), and drape a cloth with it (C8); print a per-stage summary and write everything to one folder.
+//!
+//! Long work resumes: a rerun with the same folder reuses the reference state and skips finished samples
+//! (`--fresh` starts over).
+
+use crate::fit::{fit, FitArgs};
+use crate::micro::load_pattern;
+use crate::sample::{load_plan, write_meta};
+use crate::simulate::{execute, prepare, snapshot, summary_line, Overrides};
+use hylc::fit::model::{FitOptions, FitReport};
+use hylc::micro::reference::{reference_state, Construction, ReferenceOptions};
+use hylc::micro::{MicroProblem, SolverOptions};
+use hylc::pattern::Pattern;
+use hylc::rod::YarnMaterial;
+use hylc::sample::plan::{fnv1a64, InPlaneGrid};
+use hylc::sample::{run_plan, Plan, RunOptions};
+use serde_json::json;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Settings of `hylc run`.
+pub struct RunArgs {
+    pub out: PathBuf,
+    /// generated kinds or `.pyp` files
+    pub patterns: Vec<String>,
+    /// `quick`, `reduced`, `default` or a plan file
+    pub plan: String,
+    pub scene: String,
+    pub edge: Option<f64>,
+    pub duration: Option<f64>,
+    /// time step of the cloth simulation (s)
+    pub dt: f64,
+    pub fresh: bool,
+    pub construction: Option<String>,
+}
+
+/// The held-out check of `run`: 27 in-plane points off the sampled planes (every other interior value of the
+/// original 9×9×9 grid: s_x, s_y ∈ {−0.1, 1/6, 1/2}, s_a ∈ {−0.35, 0, 0.35}).
+pub fn run_holdout_plan() -> Plan {
+    let g = InPlaneGrid::original();
+    let pick = |v: &[f64]| vec![v[1], v[3], v[5]];
+    Plan {
+        grid: Some(InPlaneGrid {
+            s_x: pick(&g.s_x),
+            s_a: vec![g.s_a[2], g.s_a[4], g.s_a[6]],
+            s_y: pick(&g.s_y),
+        }),
+        ..Plan::holdout()
+    }
+}
+
+/// A log that prints each line and keeps it in `run.log`.
+struct Log(std::fs::File, PathBuf);
+
+impl Log {
+    fn line(&mut self, text: &str) -> Result<(), String> {
+        println!("{text}");
+        writeln!(self.0, "{text}").map_err(|e| format!("{}: {e}", self.1.display()))
+    }
+}
+
+/// What one pattern's pipeline produced.
+struct PatternRun {
+    name: String,
+    stages: Vec<(&'static str, f64)>,
+    summary: serde_json::Value,
+}
+
+/// `hylc run`: Ok(true) when every stage finished (steps that ended at the Newton cap are reported, not failed).
+pub fn run(args: &RunArgs) -> Result<bool, String> {
+    let t0 = Instant::now();
+    if args.fresh && args.out.exists() {
+        std::fs::remove_dir_all(&args.out)
+            .map_err(|e| format!("{}: cannot remove: {e}", args.out.display()))?;
+    }
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("{}: cannot create: {e}", args.out.display()))?;
+    let log_path = args.out.join("run.log");
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&log_path)
+        .map_err(|e| format!("{}: {e}", log_path.display()))?;
+    let mut log = Log(file, log_path.clone());
+    log.line(&format!(
+        "hylc run: patterns {}, plan {}, scene {}; output in {}",
+        args.patterns.join(", "),
+        args.plan,
+        args.scene,
+        args.out.display()
+    ))?;
+    let mut runs = Vec::new();
+    for p in &args.patterns {
+        runs.push(run_pattern(args, p, &mut log)?);
+    }
+    let total = t0.elapsed().as_secs_f64();
+    log.line("")?;
+    log.line("summary (wall time per stage, s):")?;
+    log.line(&format!(
+        "{:<14} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}",
+        "pattern", "generate", "reference", "sample", "fit", "simulate", "total"
+    ))?;
+    for r in &runs {
+        let t: Vec<f64> = r.stages.iter().map(|s| s.1).collect();
+        log.line(&format!(
+            "{:<14} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>9.1}",
+            r.name,
+            t[0],
+            t[1],
+            t[2],
+            t[3],
+            t[4],
+            t.iter().sum::<f64>()
+        ))?;
+    }
+    for r in &runs {
+        let s = &r.summary;
+        log.line(&format!(
+            "{}: fit RMS {:.2e} (max {:.2e}) over {} samples; held-out in-plane grid RMS {:.2e} (max {:.2e}); \
+             drape: {}",
+            r.name,
+            s["fit"]["all_rms_rel"].as_f64().unwrap_or(f64::NAN),
+            s["fit"]["all_max_rel"].as_f64().unwrap_or(f64::NAN),
+            s["fit"]["samples"],
+            s["fit"]["holdout_rms_rel"].as_f64().unwrap_or(f64::NAN),
+            s["fit"]["holdout_max_rel"].as_f64().unwrap_or(f64::NAN),
+            s["simulate"]["line"].as_str().unwrap_or("")
+        ))?;
+        log.line(&format!(
+            "  outputs: {}",
+            s["outputs"]
+                .as_object()
+                .map(|o| o
+                    .iter()
+                    .map(|(k, v)| format!("{k} {}", v.as_str().unwrap_or("")))
+                    .collect::<Vec<_>>()
+                    .join(", "))
+                .unwrap_or_default()
+        ))?;
+    }
+    log.line(&format!("total {total:.1} s; log {}", log_path.display()))?;
+    let summary = json!({
+        "patterns": runs.iter().map(|r| (r.name.clone(), r.summary.clone())).collect::<serde_json::Map<_, _>>(),
+        "plan": args.plan, "scene": args.scene, "total_time": total,
+    });
+    let path = args.out.join("summary.json");
+    std::fs::write(
+        &path,
+        serde_json::to_string_pretty(&summary).expect("json") + "\n",
+    )
+    .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+    for r in &runs {
+        let n = r.summary["simulate"]["unconverged_steps"]
+            .as_u64()
+            .unwrap_or(0);
+        if n > 0 {
+            log.line(&format!(
+                "note: {}: {n} of {} drape steps ended at the Newton iteration cap (largest residual {:.2e} N; \
+                 they are in {}); a smaller --dt or a finer --edge helps",
+                r.name,
+                r.summary["simulate"]["steps"],
+                r.summary["simulate"]["max_residual"].as_f64().unwrap_or(f64::NAN),
+                r.summary["outputs"]["frames"].as_str().unwrap_or("")
+            ))?;
+        }
+    }
+    Ok(true)
+}
+
+/// The name of a pattern argument as a folder name (`stockinette`, `my.pyp` → `my`).
+fn folder_name(arg: &str) -> String {
+    Path::new(arg)
+        .file_stem()
+        .map_or_else(|| arg.to_string(), |s| s.to_string_lossy().to_string())
+}
+
+fn run_pattern(args: &RunArgs, arg: &str, log: &mut Log) -> Result<PatternRun, String> {
+    let name = folder_name(arg);
+    let dir = args.out.join(&name);
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+    let s = |f: &str| dir.join(f).display().to_string();
+    let mut stages = Vec::new();
+    log.line(&format!("\n== {name}"))?;
+
+    // 1. the pattern
+    let t = Instant::now();
+    let pattern = load_pattern(arg)?;
+    let pattern_path = dir.join("pattern.pyp");
+    pattern.save_pyp(&pattern_path).map_err(|e| e.to_string())?;
+    let pattern_hash = format!("{:016x}", fnv1a64(pattern.to_pyp_string().as_bytes()));
+    log.line(&format!(
+        "pattern: {} vertices, {} yarns, periods {:.4e} × {:.4e} m, wrote {}",
+        pattern.positions.len(),
+        pattern.yarns().len(),
+        pattern.periods[0],
+        pattern.periods[1],
+        pattern_path.display()
+    ))?;
+    stages.push(("generate", t.elapsed().as_secs_f64()));
+
+    // 2. the reference state (C1), reused when the pattern is unchanged
+    let t = Instant::now();
+    let construction = construction_of(arg, args.construction.as_deref())?;
+    let ref_path = dir.join("reference.pyp");
+    let ref_json = dir.join("reference.json");
+    let reused = std::fs::read_to_string(&ref_json)
+        .ok()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+        .filter(|v| v["pattern hash"] == pattern_hash.as_str() && ref_path.exists());
+    let reference = match reused {
+        Some(v) => {
+            log.line(&format!(
+                "reference: reused {} (pattern unchanged)",
+                ref_path.display()
+            ))?;
+            v
+        }
+        None => {
+            let (q, report) = reference_state(
+                &pattern,
+                &YarnMaterial::default(),
+                construction,
+                &SolverOptions::default(),
+                &ReferenceOptions::default(),
+            )
+            .map_err(|e| format!("{name}: reference state: {e}"))?;
+            q.save_pyp(&ref_path).map_err(|e| e.to_string())?;
+            let v = json!({"pattern hash": pattern_hash, "construction": format!("{construction:?}"),
+                           "report": report});
+            std::fs::write(
+                &ref_json,
+                serde_json::to_string_pretty(&v).expect("json") + "\n",
+            )
+            .map_err(|e| format!("{}: {e}", ref_json.display()))?;
+            log.line(&format!(
+                "reference ({construction:?}): periods {:.4e} × {:.4e} m (strain {:+.2} %, {:+.2} %), \
+                 Ψ̄(0) = {:.4e} J/m², wrote {}",
+                report.periods_out[0],
+                report.periods_out[1],
+                100.0 * report.period_strain[0],
+                100.0 * report.period_strain[1],
+                report.psi,
+                ref_path.display()
+            ))?;
+            v
+        }
+    };
+    stages.push(("reference", t.elapsed().as_secs_f64()));
+
+    // 3. sampling (C4): the plan and the held-out grid, resumable
+    let t = Instant::now();
+    let (q, _) = Pattern::load_pyp(&ref_path).map_err(|e| e.to_string())?;
+    let problem = MicroProblem::new(q, &YarnMaterial::default(), SolverOptions::default());
+    let plan = load_plan(&args.plan)?;
+    let samples = dir.join("samples.jsonl");
+    let ref_arg = ref_path.display().to_string();
+    write_meta(&samples, &ref_arg, &plan, &problem)?;
+    let opts = RunOptions {
+        cold: false,
+        shard: None,
+        limit: None,
+        progress: true,
+    };
+    let sp = run_plan(&problem, &plan, &samples, &opts)?;
+    let holdout = dir.join("holdout.jsonl");
+    let hplan = run_holdout_plan();
+    write_meta(&holdout, &ref_arg, &hplan, &problem)?;
+    let sh = run_plan(&problem, &hplan, &holdout, &opts)?;
+    log.line(&format!(
+        "samples: plan {:016x}: {} samples ({} from an earlier run, {} solved, {} of them converged); held-out \
+         grid: {} ({} solved, {} converged); {:.1} s; wrote {} and {}",
+        plan.hash(),
+        sp.selected,
+        sp.already_done,
+        sp.written,
+        sp.converged,
+        sh.selected,
+        sh.written,
+        sh.converged,
+        t.elapsed().as_secs_f64(),
+        samples.display(),
+        holdout.display()
+    ))?;
+    stages.push(("sample", t.elapsed().as_secs_f64()));
+
+    // 4. fitting (C5–C7)
+    let t = Instant::now();
+    let material = dir.join("material.json");
+    let report: FitReport = fit(
+        &samples,
+        &material,
+        &dir.join("fit.json"),
+        &dir.join("plots"),
+        FitArgs {
+            plan: None,
+            density: None,
+            holdout: vec![holdout.clone()],
+            compare: None,
+            options: FitOptions::default(),
+            plots: true,
+        },
+    )?;
+    stages.push(("fit", t.elapsed().as_secs_f64()));
+    let h = report.holdout.as_ref();
+
+    // 5. the drape (C8)
+    let t = Instant::now();
+    let ov = Overrides {
+        material: Some(material.display().to_string()),
+        duration: args.duration,
+        dt: Some(args.dt),
+        edge: args.edge,
+        psd: None,
+        no_bending: false,
+        only_1d: false,
+        in_plane_only: false,
+        quiet: false,
+        print: false,
+    };
+    let (mut scene, scene_dir) = prepare(&args.scene, &ov)?;
+    // frames at 60 per simulated second whatever the step
+    scene.output.obj_every = ((1.0 / 60.0) / args.dt).round().max(1.0) as usize;
+    let sim_dir = dir.join("simulate");
+    let o = execute(&scene, &args.scene, &scene_dir, &sim_dir, false)?;
+    let png = dir.join("snapshot.png");
+    snapshot(&png, &scene, &o)?;
+    let line = summary_line(&o.summary);
+    log.line(&format!("simulate {}: {line}", args.scene))?;
+    stages.push(("simulate", t.elapsed().as_secs_f64()));
+
+    let last = o.summary.last.as_ref();
+    let summary = json!({
+        "pattern": arg,
+        "construction": reference["construction"],
+        "reference": reference["report"],
+        "stages": stages.iter().map(|(k, v)| (k.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
+        "samples": {"plan": format!("{:016x}", plan.hash()), "selected": sp.selected,
+                    "already_done": sp.already_done, "written": sp.written, "converged": sp.converged,
+                    "holdout": sh.selected},
+        "fit": {"samples": report.samples, "converged": report.converged,
+                "all_rms_rel": report.all.rms_rel, "all_max_rel": report.all.max_rel,
+                "holdout_rms_rel": h.map(|e| e.rms_rel), "holdout_max_rel": h.map(|e| e.max_rel),
+                "constant": report.constant},
+        "simulate": {"scene": args.scene, "line": line, "steps": o.summary.steps,
+                     "triangles": o.summary.triangles, "newton_total": o.summary.newton_total,
+                     "unconverged_steps": o.summary.unconverged_steps,
+                     "max_residual": o.summary.max_residual, "wall": o.summary.wall,
+                     "final_kinetic": last.map(|r| r.energy_kinetic),
+                     "final_elastic": last.map(|r| r.energy_elastic)},
+        "outputs": {"pattern": s("pattern.pyp"), "reference": s("reference.pyp"), "samples": s("samples.jsonl"),
+                    "material": s("material.json"), "fit report": s("fit.json"), "plots": s("plots"),
+                    "frames": s("simulate"), "snapshot": s("snapshot.png")},
+    });
+    Ok(PatternRun {
+        name,
+        stages,
+        summary,
+    })
+}
+
+/// The construction of a pattern argument (it selects C1's tension factors): `--construction` when given, else
+/// knitted for the generated stockinette and woven for the other generated kinds; a file needs the flag.
+fn construction_of(arg: &str, flag: Option<&str>) -> Result<Construction, String> {
+    match flag {
+        Some("knitted") | Some("knit") => Ok(Construction::Knitted),
+        Some("woven") | Some("weave") => Ok(Construction::Woven),
+        Some(other) => Err(format!(
+            "--construction: expected knitted or woven, got {other:?}"
+        )),
+        None if Path::new(arg).exists() => Err(format!(
+            "{arg}: pass --construction knitted|woven (it selects the tension factors of the reference state)"
+        )),
+        None if arg == "stockinette" => Ok(Construction::Knitted),
+        None => Ok(Construction::Woven),
+    }
+}

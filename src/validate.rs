@@ -1,0 +1,180 @@
+//! Validation against the original method's data (`../shared/design/06-verification.md`, section 3): the
+//! measurements behind `hylc validate` and the conformance tests. Each function reads `../shared` (the caller
+//! passes the folder) and returns numbers; the callers decide what passes.
+
+use crate::material::Material;
+use crate::shell::{RestTriangle, StrainChain};
+use serde::Serialize;
+use serde_json::Value;
+use std::path::Path;
+
+/// The five original materials, by file stem.
+pub const ORIGINAL_MATERIALS: [&str; 5] = ["basket1", "honey1", "rib1", "satin1", "stock1"];
+
+/// ‖a − b‖ / ‖b‖ (normwise relative error).
+pub fn rel_norm(a: &[f64], b: &[f64]) -> f64 {
+    let d: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| (x - y) * (x - y))
+        .sum::<f64>()
+        .sqrt();
+    let n: f64 = b.iter().map(|y| y * y).sum::<f64>().sqrt();
+    d / n.max(f64::MIN_POSITIVE)
+}
+
+fn nums(v: &Value) -> Result<Vec<f64>, String> {
+    match v {
+        Value::Array(a) => Ok(a.iter().map(nums).collect::<Result<Vec<_>, _>>()?.concat()),
+        Value::Number(n) => Ok(vec![n.as_f64().unwrap_or(f64::NAN)]),
+        _ => Err(format!("expected numbers, got {v}")),
+    }
+}
+
+fn read_json(path: &Path) -> Result<Value, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Largest relative normwise errors of value, first and second derivatives over a set of oracle cases, and the
+/// cases beyond the given tolerances.
+#[derive(Clone, Debug, Serialize)]
+pub struct Conformance {
+    pub name: String,
+    pub cases: usize,
+    pub value: f64,
+    pub first: f64,
+    pub second: f64,
+    /// one line per case beyond the tolerances
+    pub failures: Vec<String>,
+}
+
+/// Item 3a for ψ: ψ, ∇ψ, ∇²ψ of each original material against `oracles/psi_oracle.json`; cases beyond `tol`
+/// (value and gradient) or `tol_hess` are listed.
+pub fn psi_conformance(shared: &Path, tol: f64, tol_hess: f64) -> Result<Vec<Conformance>, String> {
+    let path = shared.join("oracles/psi_oracle.json");
+    let oracle = read_json(&path)?;
+    let mut out = Vec::new();
+    for name in ORIGINAL_MATERIALS {
+        let mat = Material::load(&shared.join(format!("data/hylc2020/materials/{name}.json")))
+            .map_err(|e| e.to_string())?;
+        let samples = oracle["materials"][name]["samples"]
+            .as_array()
+            .ok_or_else(|| format!("{}: no samples for {name}", path.display()))?;
+        let mut c = Conformance {
+            name: name.to_string(),
+            cases: samples.len(),
+            value: 0.0,
+            first: 0.0,
+            second: 0.0,
+            failures: vec![],
+        };
+        for s in samples {
+            let z = nums(&s["z"])?;
+            if z.len() != 6 {
+                return Err(format!(
+                    "{}: {name}: a strain without 6 entries",
+                    path.display()
+                ));
+            }
+            let r = mat.eval(&[z[0], z[1], z[2], z[3], z[4], z[5]]);
+            let hv: Vec<f64> = r.hess.iter().flatten().copied().collect();
+            let psi = s["psi"].as_f64().unwrap_or(f64::NAN);
+            let e = [
+                rel_norm(&[r.value], &[psi]),
+                rel_norm(&r.grad, &nums(&s["grad"])?),
+                rel_norm(&hv, &nums(&s["hess"])?),
+            ];
+            if e.iter().any(|v| v.is_nan()) || e[0] > tol || e[1] > tol || e[2] > tol_hess {
+                c.failures.push(format!(
+                    "{name} #{} ({}) z={z:?}: psi {:.2e} grad {:.2e} hess {:.2e}",
+                    s["id"], s["kind"], e[0], e[1], e[2]
+                ));
+            }
+            c.value = c.value.max(e[0]);
+            c.first = c.first.max(e[1]);
+            c.second = c.second.max(e[2]);
+        }
+        out.push(c);
+    }
+    Ok(out)
+}
+
+/// Item 3a for the strain chain: z, the 6×18 Jacobian and the 6×18×18 Hessian of `oracles/strain_oracle.json`'s
+/// cases, at the stored positions and translated 2 m from the origin; cases beyond `tol` are listed.
+pub fn strain_conformance(shared: &Path, tol: f64) -> Result<Conformance, String> {
+    let path = shared.join("oracles/strain_oracle.json");
+    let oracle = read_json(&path)?;
+    let cases = oracle["cases"]
+        .as_array()
+        .ok_or_else(|| format!("{}: no cases", path.display()))?;
+    let mut c = Conformance {
+        name: "strain chain".into(),
+        cases: 2 * cases.len(),
+        value: 0.0,
+        first: 0.0,
+        second: 0.0,
+        failures: vec![],
+    };
+    for shift in [0.0, 2.0] {
+        for case in cases {
+            let xloc = nums(&case["xloc"])?;
+            let d = nums(&case["invDm"])?;
+            let ex = nums(&case["niexists"])?;
+            if xloc.len() != 18 || d.len() != 4 || ex.len() != 3 {
+                return Err(format!(
+                    "{}: case {}: malformed",
+                    path.display(),
+                    case["id"]
+                ));
+            }
+            let flaps = [ex[0] != 0.0, ex[1] != 0.0, ex[2] != 0.0];
+            let rest = RestTriangle::from_inv_dm([[d[0], d[1]], [d[2], d[3]]]);
+            let mut q = [0.0; 18];
+            for j in 0..18 {
+                // a missing flap is stored as the origin: leave it there (it does not enter)
+                let flap = j / 3 >= 3 && !flaps[j / 3 - 3];
+                q[j] = xloc[j]
+                    + if flap {
+                        0.0
+                    } else {
+                        shift * [1.0, -0.6, 0.8][j % 3]
+                    };
+            }
+            let chain = StrainChain::new(&q, &rest, flaps).ok_or_else(|| {
+                format!(
+                    "{}: case {}: degenerate triangle",
+                    path.display(),
+                    case["id"]
+                )
+            })?;
+            let mut z = chain.z;
+            // the original's stretches are not shifted by 1
+            z[0] += 1.0;
+            z[2] += 1.0;
+            let jac: Vec<f64> = chain.jac.iter().flatten().copied().collect();
+            let mut hess = Vec::new();
+            for k in 0..6 {
+                let mut w = [0.0; 6];
+                w[k] = 1.0;
+                hess.extend(chain.weighted_hessian(&w).iter().flatten().copied());
+            }
+            let e = [
+                rel_norm(&z, &nums(&case["value"])?),
+                rel_norm(&jac, &nums(&case["grad"])?),
+                rel_norm(&hess, &nums(&case["hess"])?),
+            ];
+            if e.iter().any(|&v| v.is_nan() || v > tol) {
+                c.failures.push(format!(
+                    "case {} ({}) shift {shift} m: value {:.2e} jacobian {:.2e} hessian {:.2e}",
+                    case["id"], case["kind"], e[0], e[1], e[2]
+                ));
+            }
+            c.value = c.value.max(e[0]);
+            c.first = c.first.max(e[1]);
+            c.second = c.second.max(e[2]);
+        }
+    }
+    Ok(c)
+}

@@ -1,0 +1,136 @@
+//! The main job end to end (issue 7; `01-architecture.md`, "Command line": `run`) on a small configuration: the
+//! plain weave, a 7-per-range / 5×5 plan, a 3 cm mesh and 0.05 s of drape. Every stage writes its outputs, the
+//! material loads and is ψ(0)-consistent with the fit report, the summary names the stages, and a rerun resumes
+//! (no sample solved twice, the reference state reused). Also `scene-plan` on the run's strain log.
+
+mod common;
+
+use hylc::material::Material;
+use hylc::sample::Plan;
+use std::path::PathBuf;
+use std::process::Command;
+
+fn hylc(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
+        .args(args)
+        .output()
+        .expect("run hylc");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).to_string(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+    )
+}
+
+#[test]
+fn run_writes_every_stage_and_resumes() {
+    let dir = std::env::temp_dir().join(format!("hylc-run-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let plan = dir.join("small.json");
+    let mut p = Plan::reduced();
+    p.count_1d = 7;
+    p.count_2d = 5;
+    std::fs::write(&plan, serde_json::to_string(&p).unwrap()).unwrap();
+    let out = dir.join("out");
+    let args = [
+        "run",
+        "--pattern",
+        "plain",
+        "--plan",
+        plan.to_str().unwrap(),
+        "--edge",
+        "0.03",
+        "--duration",
+        "0.05",
+        "--dt",
+        "0.0125",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    let (ok, stdout, stderr) = hylc(&args);
+    assert!(ok, "{stdout}\n{stderr}");
+    let d = out.join("plain");
+    for f in [
+        "pattern.pyp",
+        "reference.pyp",
+        "reference.json",
+        "samples.jsonl",
+        "samples.meta.json",
+        "holdout.jsonl",
+        "material.json",
+        "fit.json",
+        "plots/1d_s_x.png",
+        "plots/2d_s_x_s_a.png",
+        "simulate/log.jsonl",
+        "simulate/frame_0000.obj",
+        "simulate/frame_0004.obj",
+        "snapshot.png",
+    ] {
+        assert!(d.join(f).exists(), "{f} missing");
+    }
+    assert!(out.join("run.log").exists() && out.join("summary.json").exists());
+    // the material is the fit's: ψ(0) = f₀ of the report
+    let m = Material::load(&d.join("material.json")).unwrap();
+    let rep: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("fit.json")).unwrap()).unwrap();
+    let f0 = rep["constant"].as_f64().unwrap();
+    assert!((m.eval(&[0.0; 6]).value - f0).abs() <= 1e-12 * f0.abs());
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let ps = &s["patterns"]["plain"];
+    let n = 5 * 7 + 9 * 25;
+    assert_eq!(ps["samples"]["selected"], n);
+    assert_eq!(ps["samples"]["written"], n);
+    assert_eq!(ps["simulate"]["steps"], 4);
+    for stage in ["generate", "reference", "sample", "fit", "simulate"] {
+        assert!(ps["stages"][stage].as_f64().unwrap() >= 0.0, "{stage}");
+    }
+    assert!(ps["fit"]["holdout_rms_rel"].as_f64().unwrap().is_finite());
+    assert!(
+        stdout.contains("summary (wall time per stage, s):"),
+        "{stdout}"
+    );
+
+    // a rerun resumes: the reference is reused and no sample is solved again
+    let (ok, stdout, stderr) = hylc(&args);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(stdout.contains("reference: reused"), "{stdout}");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let ps = &s["patterns"]["plain"];
+    assert_eq!(ps["samples"]["already_done"], n);
+    assert_eq!(ps["samples"]["written"], 0);
+
+    // scene-driven sampling from the drape's strain log: a valid plan, smaller than the default one
+    let sp = dir.join("scene_plan.json");
+    let log = d.join("simulate/log.jsonl");
+    let (ok, stdout, stderr) = hylc(&[
+        "scene-plan",
+        log.to_str().unwrap(),
+        "--write",
+        sp.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    let plan = Plan::load(&sp).unwrap();
+    assert!(plan.len() < Plan::default().len());
+    assert!(
+        stdout.contains("fewer solves than the base plan"),
+        "{stdout}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn run_and_scene_plan_reject_bad_input_with_one_line() {
+    let e = common::cli_error(&["run", "--pattern", "hexagon", "--out", "/tmp/hylc-run-bad"]);
+    assert!(e.contains("hexagon"), "{e}");
+    let missing = PathBuf::from("/nonexistent/log.jsonl");
+    let e = common::cli_error(&[
+        "scene-plan",
+        missing.to_str().unwrap(),
+        "--write",
+        "/tmp/x.json",
+    ]);
+    assert!(e.contains("/nonexistent/log.jsonl: cannot read"), "{e}");
+}
