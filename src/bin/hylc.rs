@@ -255,6 +255,9 @@ enum Command {
         /// margin added on each side, as a fraction of each visited interval
         #[arg(long, default_value_t = 0.1)]
         margin: f64,
+        /// cover every triangle's strains (the logs' min/max) instead of the 1st to 99th percentiles
+        #[arg(long)]
+        all_triangles: bool,
     },
     /// Write the default sampling plan (or the reduced one) as JSON.
     Plan {
@@ -557,7 +560,9 @@ fn main() -> ExitCode {
             write,
             base,
             margin,
-        } => sample::scene_plan_cmd(&logs, &write, &base, margin).map(|_| ExitCode::SUCCESS),
+            all_triangles,
+        } => sample::scene_plan_cmd(&logs, &write, &base, margin, all_triangles)
+            .map(|_| ExitCode::SUCCESS),
         Command::Merge { out, inputs } => {
             sample::merge_cmd(&out, &inputs).map(|_| ExitCode::SUCCESS)
         }

@@ -219,10 +219,11 @@ pub fn fit_material(
     opts: &FitOptions,
 ) -> Result<MaterialFit, FitError> {
     let hash = format!("{:016x}", plan.hash());
-    if plan.count_1d < 3 {
+    if let Some(k) = (0..5).find(|&k| plan.n_1d(k) < 3) {
         return Err(FitError::BadOption(format!(
-            "the plan has {} samples per 1D range; fitting needs at least 3",
-            plan.count_1d
+            "the plan has {} samples on the 1D range of {}; fitting needs at least 3",
+            plan.n_1d(k),
+            STRAIN_NAMES[k]
         )));
     }
     let n = plan.len();
@@ -259,8 +260,10 @@ pub fn fit_material(
     // 1D terms
     let mut fits1d = Vec::new();
     for k in 0..5 {
-        let idx: Vec<usize> = (k * plan.count_1d..(k + 1) * plan.count_1d)
-            .filter(|i| (i - k * plan.count_1d).is_multiple_of(opts.thin_1d.max(1)))
+        let range = plan.range_1d(k);
+        let idx: Vec<usize> = range
+            .clone()
+            .filter(|i| (i - range.start).is_multiple_of(opts.thin_1d.max(1)))
             .collect();
         let x: Vec<f64> = idx.iter().map(|&i| samples[i].z[k] / sigma[k]).collect();
         let psi: Vec<f64> = idx.iter().map(|&i| psi_of(i)).collect();
@@ -293,7 +296,7 @@ pub fn fit_material(
         fits1d.push((k, fit, TermData { x, y: vec![], psi }));
     }
     // prefer the s_a range (Ψ̄ is even in s_a, so its error is second order); any sample otherwise
-    let sa_range = plan.count_1d..2 * plan.count_1d;
+    let sa_range = plan.range_1d(1);
     let on_sa = present
         .iter()
         .any(|r| sa_range.contains(&r.index) && r.psi.is_some_and(f64::is_finite));
@@ -318,15 +321,13 @@ pub fn fit_material(
 
     // 2D terms
     let mut fits2d = Vec::new();
-    let m2 = plan.count_2d;
     for (p, [a, b]) in plan.pairs.iter().enumerate() {
         let (ka, kb) = (
             crate::sample::plan::strain_index(a).unwrap_or(0),
             crate::sample::plan::strain_index(b).unwrap_or(0),
         );
         let (k0, k1) = (ka.min(kb), ka.max(kb));
-        let base = 5 * plan.count_1d + p * m2 * m2;
-        let idx: Vec<usize> = (base..base + m2 * m2).collect();
+        let idx: Vec<usize> = plan.range_2d(p).collect();
         let x: Vec<f64> = idx.iter().map(|&i| samples[i].z[k0] / sigma[k0]).collect();
         let y: Vec<f64> = idx.iter().map(|&i| samples[i].z[k1] / sigma[k1]).collect();
         let psi: Vec<f64> = idx.iter().map(|&i| psi_of(i)).collect();
@@ -403,27 +404,24 @@ pub fn fit_material(
             fit_max_rel: f.report.max_rel,
             offset: f.offset,
             i_min: f.report.i_min,
-            model: model_error(&material, recs(k * plan.count_1d..(k + 1) * plan.count_1d)),
+            model: model_error(&material, recs(plan.range_1d(*k))),
         })
         .collect();
     let terms2d: Vec<Term2DReport> = fits2d
         .iter()
         .enumerate()
-        .map(|(p, (k0, k1, f, _))| {
-            let base = 5 * plan.count_1d + p * m2 * m2;
-            Term2DReport {
-                k0: *k0,
-                k1: *k1,
-                strains: [STRAIN_NAMES[*k0].to_string(), STRAIN_NAMES[*k1].to_string()],
-                n_samples: f.report.n_samples,
-                n_excluded: f.report.n_excluded,
-                fit_rms_rel: f.report.rms_rel,
-                fit_max_rel: f.report.max_rel,
-                twist_rounds: f.report.twist_rounds,
-                slope_rounds: f.report.slope_rounds,
-                nonmonotone_patches: f.report.nonmonotone_patches,
-                model: model_error(&material, recs(base..base + m2 * m2)),
-            }
+        .map(|(p, (k0, k1, f, _))| Term2DReport {
+            k0: *k0,
+            k1: *k1,
+            strains: [STRAIN_NAMES[*k0].to_string(), STRAIN_NAMES[*k1].to_string()],
+            n_samples: f.report.n_samples,
+            n_excluded: f.report.n_excluded,
+            fit_rms_rel: f.report.rms_rel,
+            fit_max_rel: f.report.max_rel,
+            twist_rounds: f.report.twist_rounds,
+            slope_rounds: f.report.slope_rounds,
+            nonmonotone_patches: f.report.nonmonotone_patches,
+            model: model_error(&material, recs(plan.range_2d(p))),
         })
         .collect();
     let all = model_error(&material, recs(0..plan.grid_start()));
@@ -553,7 +551,7 @@ pub fn compare_1d(
         let interval = [t[0] / 0.95 * sig, t[t.len() - 1] / 0.95 * sig];
         let (mut s2, mut so2, mut t2, mut to2) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
         let mut pts = Vec::new();
-        for i in k * plan.count_1d..(k + 1) * plan.count_1d {
+        for i in plan.range_1d(k) {
             let z = samples[i].z;
             if z[k] < interval[0] - 1e-12 || z[k] > interval[1] + 1e-12 {
                 continue;

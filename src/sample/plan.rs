@@ -100,6 +100,13 @@ pub struct Plan {
     /// report"). Absent from the JSON (and from the hash) when `None`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grid: Option<InPlaneGrid>,
+    /// Optional samples per 1D range, one count per strain (s_x, s_a, s_y, II00, II11), overriding `count_1d`
+    /// (a scene plan keeps the default spacing on each range it narrows). Absent: `count_1d` for every range.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub counts_1d: Option<[usize; 5]>,
+    /// Optional samples per axis of each 2D grid, one [first, second] per pair, overriding `count_2d`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub counts_2d: Option<Vec<[usize; 2]>>,
 }
 
 /// The explicit axis values of an in-plane tensor grid (samples (s_x, s_a, s_y, 0, 0), s_x index outermost).
@@ -163,6 +170,8 @@ impl Default for Plan {
             pairs: default_pairs(),
             ranges_2d: None,
             grid: None,
+            counts_1d: None,
+            counts_2d: None,
         }
     }
 }
@@ -321,7 +330,43 @@ impl Plan {
 
     /// Index of the first in-plane grid sample (after the 1D ranges and the 2D grids).
     pub fn grid_start(&self) -> usize {
-        5 * self.count_1d + self.pairs.len() * self.count_2d * self.count_2d
+        self.range_2d(self.pairs.len()).start
+    }
+
+    /// Samples of the 1D range of strain `k`.
+    pub fn n_1d(&self, k: usize) -> usize {
+        self.counts_1d.map_or(self.count_1d, |c| c[k])
+    }
+
+    /// Samples per axis [first, second] of pair `p`'s grid.
+    pub fn n_2d(&self, p: usize) -> [usize; 2] {
+        self.counts_2d
+            .as_ref()
+            .and_then(|c| c.get(p).copied())
+            .unwrap_or([self.count_2d; 2])
+    }
+
+    /// Sample indices of the 1D range of strain `k` (`k` = 5: the empty range after the last).
+    pub fn range_1d(&self, k: usize) -> std::ops::Range<usize> {
+        let start: usize = (0..k).map(|j| self.n_1d(j)).sum();
+        start..start + if k < 5 { self.n_1d(k) } else { 0 }
+    }
+
+    /// Sample indices of pair `p`'s grid, row-major (`p` = number of pairs: the empty range after the last).
+    pub fn range_2d(&self, p: usize) -> std::ops::Range<usize> {
+        let start = self.range_1d(5).start
+            + (0..p)
+                .map(|q| {
+                    let [a, b] = self.n_2d(q);
+                    a * b
+                })
+                .sum::<usize>();
+        let [a, b] = if p < self.pairs.len() {
+            self.n_2d(p)
+        } else {
+            [0, 0]
+        };
+        start..start + a * b
     }
 
     /// Check ranges, counts and pairs.
@@ -349,6 +394,14 @@ impl Plan {
                 return Err(err(
                     format!("ranges.{name}"),
                     format!("[{lo}, {hi}] must contain 0 (SAMPLERANGE mirrors √|z| about 0)"),
+                ));
+            }
+        }
+        if let Some(c2) = &self.counts_2d {
+            if c2.len() != self.pairs.len() {
+                return Err(err(
+                    "counts_2d".into(),
+                    format!("{} entries for {} pairs", c2.len(), self.pairs.len()),
                 ));
             }
         }
@@ -441,13 +494,15 @@ impl Plan {
         let obj = value
             .as_object()
             .ok_or_else(|| err("-", "a plan is a JSON object".into()))?;
-        const FIELDS: [&str; 6] = [
+        const FIELDS: [&str; 8] = [
             "ranges",
             "count_1d",
             "count_2d",
             "pairs",
             "ranges_2d",
             "grid",
+            "counts_1d",
+            "counts_2d",
         ];
         for key in obj.keys() {
             if !FIELDS.contains(&key.as_str()) {
@@ -500,6 +555,14 @@ impl Plan {
                 None | Some(serde_json::Value::Null) => None,
                 Some(_) => Some(field(obj, "grid").map_err(|m| err("grid", m))?),
             },
+            counts_1d: match obj.get("counts_1d") {
+                None | Some(serde_json::Value::Null) => None,
+                Some(_) => Some(field(obj, "counts_1d").map_err(|m| err("counts_1d", m))?),
+            },
+            counts_2d: match obj.get("counts_2d") {
+                None | Some(serde_json::Value::Null) => None,
+                Some(_) => Some(field(obj, "counts_2d").map_err(|m| err("counts_2d", m))?),
+            },
         };
         plan.validate().map_err(|mut e| {
             e.file = file.map(str::to_string);
@@ -532,7 +595,7 @@ impl Plan {
     /// The values of strain `k` on its 1D range.
     pub fn axis_1d(&self, k: usize) -> Vec<f64> {
         let [lo, hi] = self.ranges.get(k);
-        sample_range(k, lo, hi, self.count_1d)
+        sample_range(k, lo, hi, self.n_1d(k))
     }
 
     /// The values of side `side` (0: the first strain, 1: the second) of pair `p`'s grid axis: SAMPLERANGE over
@@ -543,10 +606,10 @@ impl Plan {
             Some(r) => r[p][side],
             None => self.ranges.get(k),
         };
-        sample_range(k, lo, hi, self.count_2d)
+        sample_range(k, lo, hi, self.n_2d(p)[side])
     }
 
-    /// Number of samples: 5 · count_1d + pairs · count_2d² + the in-plane grid's points.
+    /// Number of samples: the 1D ranges, the 2D grids and the in-plane grid's points.
     pub fn len(&self) -> usize {
         self.grid_start() + self.grid.as_ref().map_or(0, InPlaneGrid::len)
     }
@@ -564,7 +627,7 @@ impl Plan {
     }
 
     /// All samples in plan order: the 1D ranges of s_x, s_a, s_y, Π₀₀, Π₁₁ (others 0), then each pair's grid,
-    /// row-major (index i of the first strain, j of the second: i·count_2d + j).
+    /// row-major (index i of the first strain, j of the second: i · (second axis count) + j).
     pub fn samples(&self) -> Vec<Sample> {
         let hash = self.hash();
         let mut zs: Vec<[f64; 5]> = Vec::with_capacity(self.len());
@@ -611,7 +674,7 @@ impl Plan {
     pub fn chains(&self) -> Vec<Chain> {
         let mut chains = Vec::new();
         for k in 0..5 {
-            let base = k * self.count_1d;
+            let base = self.range_1d(k).start;
             let values = self.axis_1d(k);
             if values.is_empty() {
                 continue;
@@ -625,17 +688,17 @@ impl Plan {
             push_ray(&mut steps, 0, down.into_iter().map(|i| base + i));
             chains.push(Chain { steps });
         }
-        let n = self.count_2d;
         for p in 0..self.pairs.len() {
-            if n == 0 {
+            let [na, nb] = self.n_2d(p);
+            if na == 0 || nb == 0 {
                 continue;
             }
-            let base = 5 * self.count_1d + p * n * n;
-            let at = |i: usize, j: usize| base + i * n + j;
+            let base = self.range_2d(p).start;
+            let at = |i: usize, j: usize| base + i * nb + j;
             let steps = grid_chain(
                 &rays(&self.axis_2d(p, 0)),
                 &rays(&self.axis_2d(p, 1)),
-                n,
+                na,
                 at,
             );
             chains.push(Chain { steps });
@@ -875,12 +938,38 @@ mod tests {
 
     #[test]
     fn chains_cover_every_sample_once_and_start_near_zero() {
-        let p = Plan {
+        let uniform = Plan {
             count_1d: 7,
             count_2d: 5,
             ..Plan::reduced()
         };
+        // per-range counts: different on every range and both axes of every grid
+        let per_range = Plan {
+            counts_1d: Some([7, 4, 9, 5, 6]),
+            counts_2d: Some((0..9).map(|p| [3 + p % 4, 5 + p % 3]).collect()),
+            ..uniform.clone()
+        };
+        assert_eq!(
+            per_range.len(),
+            31 + (0..9).map(|p| (3 + p % 4) * (5 + p % 3)).sum::<usize>()
+        );
+        let text = serde_json::to_string(&per_range).unwrap();
+        assert_eq!(Plan::from_json(&text, None).unwrap(), per_range);
+        assert!(!serde_json::to_string(&uniform).unwrap().contains("counts_"));
+        for p in [uniform, per_range] {
+            check_chains(&p);
+        }
+    }
+
+    fn check_chains(p: &Plan) {
+        for k in 0..5 {
+            let r = p.range_1d(k);
+            for (i, v) in p.axis_1d(k).into_iter().enumerate() {
+                assert_eq!(p.samples()[r.start + i].z[k], v);
+            }
+        }
         let samples = p.samples();
+        assert_eq!(samples.len(), p.len());
         let chains = p.chains();
         assert_eq!(chains.len(), 5 + 9);
         let mut seen = vec![0; p.len()];

@@ -52,9 +52,15 @@ impl StrainExtent {
         ]
     }
 
-    /// Read the `strain_min`/`strain_max` of every line of a `hylc simulate` log (`log.jsonl`); errors name
-    /// the file and line.
-    pub fn read_log(path: &Path, into: &mut StrainExtent) -> Result<(), String> {
+    /// Read the extremes of every line of a `hylc simulate` log (`log.jsonl`): `strain_min`/`strain_max`
+    /// (`outliers` true: every triangle) or the 1st/99th percentiles `strain_p01`/`strain_p99` (false: what 98 % of
+    /// the triangles visit in each step, without the few of a mesh-scale crease); errors name the file and line.
+    pub fn read_log(path: &Path, into: &mut StrainExtent, outliers: bool) -> Result<(), String> {
+        let (kmin, kmax) = if outliers {
+            ("strain_min", "strain_max")
+        } else {
+            ("strain_p01", "strain_p99")
+        };
         let text = std::fs::read_to_string(path)
             .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
         let mut n = 0;
@@ -92,7 +98,7 @@ impl StrainExtent {
                 }
                 Ok(out)
             };
-            into.add(&get("strain_min")?, &get("strain_max")?);
+            into.add(&get(kmin)?, &get(kmax)?);
             n += 1;
         }
         if n == 0 {
@@ -127,9 +133,9 @@ pub struct ScenePlanReport {
 
 /// A plan covering `extent` plus `margin` (a fraction of each visited interval's length, and at least
 /// `margin` × 5 % of the base range on each side of 0, so that every range keeps a neighbourhood of the rest
-/// state), clipped to the base ranges, with the counts scaled so that the spacing of the base plan is kept on the
-/// widest range (one count serves all 1D ranges and one all 2D grids). Counts never fall below 7 (1D) and 5
-/// (2D), which the fits need.
+/// state), clipped to the base ranges, with per-range counts (`counts_1d`, `counts_2d`) scaled so that every
+/// range and every grid axis keeps the base plan's sample spacing. Counts never fall below 7 (1D) and 5 (2D),
+/// which the fits need.
 pub fn scene_plan(base: &Plan, extent: &StrainExtent, margin: f64) -> (Plan, ScenePlanReport) {
     let visited = extent.plan_intervals();
     let mut ranges = [[0.0; 2]; 5];
@@ -146,12 +152,6 @@ pub fn scene_plan(base: &Plan, extent: &StrainExtent, margin: f64) -> (Plan, Sce
             / (spacing_coordinate(k, bhi) - spacing_coordinate(k, blo));
     }
     let idx = |name: &str| super::plan::strain_index(name).unwrap_or(0);
-    let f1 = fraction.iter().cloned().fold(0.0, f64::max);
-    let f2 = base
-        .pairs
-        .iter()
-        .map(|[a, b]| fraction[idx(a)].max(fraction[idx(b)]))
-        .fold(0.0, f64::max);
     // n samples over a share f of the spacing axis keep the base spacing when n − 1 ≥ f (N − 1)
     let count = |n: usize, f: f64, min: usize| {
         ((f * n.saturating_sub(1) as f64 - 1e-9).ceil().max(0.0) as usize + 1).clamp(min.min(n), n)
@@ -164,11 +164,25 @@ pub fn scene_plan(base: &Plan, extent: &StrainExtent, margin: f64) -> (Plan, Sce
             ii00: ranges[3],
             ii11: ranges[4],
         },
-        count_1d: count(base.count_1d, f1, 7),
-        count_2d: count(base.count_2d, f2, 5),
+        count_1d: base.count_1d,
+        count_2d: base.count_2d,
         pairs: base.pairs.clone(),
         ranges_2d: None,
         grid: None,
+        counts_1d: Some(std::array::from_fn(|k| count(base.n_1d(k), fraction[k], 7))),
+        counts_2d: Some(
+            base.pairs
+                .iter()
+                .enumerate()
+                .map(|(p, [a, b])| {
+                    let [na, nb] = base.n_2d(p);
+                    [
+                        count(na, fraction[idx(a)], 5),
+                        count(nb, fraction[idx(b)], 5),
+                    ]
+                })
+                .collect(),
+        ),
     };
     let report = ScenePlanReport {
         visited,
@@ -191,7 +205,7 @@ mod tests {
     }
 
     /// A scene that visits the whole base range gets the base plan's counts; a narrow one gets fewer samples,
-    /// ranges that contain the visited interval and 0, and the base spacing on its widest range.
+    /// ranges that contain the visited interval and 0, and the base spacing on every range.
     #[test]
     fn narrow_scene_saves_samples_and_covers_what_it_visited() {
         let base = Plan::default();
@@ -200,7 +214,8 @@ mod tests {
             [0.96, 0.7, 0.96, 160.0, 0.0, 160.0],
         );
         let (p, r) = scene_plan(&base, &wide, 0.1);
-        assert_eq!((p.count_1d, p.count_2d), (base.count_1d, base.count_2d));
+        assert_eq!(p.counts_1d, Some([150; 5]));
+        assert_eq!(p.counts_2d, Some(vec![[50, 50]; 9]));
         assert_eq!(r.samples, base.len());
         let narrow = extent(
             [-0.02, -0.05, -0.01, -20.0, -3.0, -10.0],
@@ -224,12 +239,24 @@ mod tests {
         }
         // bending: Gershgorin bound max(|II00|, |II11|) + |II01| = 30 + 3, plus 10 % of its 66 span
         assert!((p.ranges.ii00[1] - 33.0 * 1.0 - 6.6).abs() < 1e-12);
-        // spacing on the widest range is at most the base spacing
-        let widest = (0..5)
-            .max_by(|&a, &b| r.fraction[a].total_cmp(&r.fraction[b]))
-            .unwrap();
+        // every range and grid axis keeps at most the base spacing (unless at the minimum count), and the
+        // narrow s_y range gets fewer samples than the bending ranges, which the bound keeps wide
         let step = |n: usize, f: f64| f / (n - 1) as f64;
-        assert!(step(p.count_1d, r.fraction[widest]) <= step(base.count_1d, 1.0) + 1e-12);
+        for k in 0..5 {
+            let n = p.n_1d(k);
+            assert!(
+                n == 7 || step(n, r.fraction[k]) <= step(base.count_1d, 1.0) + 1e-12,
+                "range {k}"
+            );
+        }
+        for (q, [a, b]) in p.pairs.iter().enumerate() {
+            for (side, name) in [a, b].into_iter().enumerate() {
+                let k = crate::sample::plan::strain_index(name).unwrap();
+                let n = p.n_2d(q)[side];
+                assert!(n == 5 || step(n, r.fraction[k]) <= step(base.count_2d, 1.0) + 1e-12);
+            }
+        }
+        assert!(p.n_1d(2) < p.n_1d(3));
     }
 
     /// Bad logs get one line naming the file and the line.
@@ -243,14 +270,14 @@ mod tests {
             "{\"strain_min\":[0,0,0,0,0,0],\"strain_max\":[0,0,0,0,0,0]}\n{\"step\":2}\n",
         )
         .unwrap();
-        let e = StrainExtent::read_log(&f, &mut StrainExtent::empty()).unwrap_err();
+        let e = StrainExtent::read_log(&f, &mut StrainExtent::empty(), true).unwrap_err();
         assert!(e.contains("log.jsonl:2: no `strain_min`"), "{e}");
         std::fs::write(
             &f,
             "{\"strain_min\":[0,0,0,0,0],\"strain_max\":[0,0,0,0,0,0]}\n",
         )
         .unwrap();
-        let e = StrainExtent::read_log(&f, &mut StrainExtent::empty()).unwrap_err();
+        let e = StrainExtent::read_log(&f, &mut StrainExtent::empty(), true).unwrap_err();
         assert!(e.contains(":1: `strain_min` has 5 entries"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }

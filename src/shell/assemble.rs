@@ -164,6 +164,8 @@ pub struct Assembled {
     /// componentwise min and max of z over the mesh
     pub zmin: [f64; 6],
     pub zmax: [f64; 6],
+    /// z of every triangle, in stencil order
+    pub z: Vec<[f64; 6]>,
 }
 
 /// Elastic energy only; `None` if any triangle is degenerate.
@@ -194,6 +196,7 @@ pub fn assemble(
             values_exact: vec![0.0; if exact_too { pattern.nnz() } else { 0 }],
             zmin: [0.0; 6],
             zmax: [0.0; 6],
+            z: vec![],
         });
     }
     let nthreads = rayon::current_num_threads().max(1);
@@ -210,6 +213,7 @@ pub fn assemble(
                 values_exact: vec![0.0; if exact_too { nnz } else { 0 }],
                 zmin: [f64::INFINITY; 6],
                 zmax: [f64::NEG_INFINITY; 6],
+                z: Vec::with_capacity(ss.len()),
             };
             let mut g = [0.0; NDOF];
             let mut h = [[0.0; NDOF]; NDOF];
@@ -224,6 +228,7 @@ pub fn assemble(
                     model.energy_gradient(&q, &s.rest, s.flaps, &mut g)?
                 };
                 out.energy += e;
+                out.z.push(z);
                 for k in 0..6 {
                     out.zmin[k] = out.zmin[k].min(z[k]);
                     out.zmax[k] = out.zmax[k].max(z[k]);
@@ -266,7 +271,9 @@ pub fn assemble(
         })
         .collect();
     let mut parts: Vec<Assembled> = parts.into_iter().collect::<Option<Vec<_>>>()?;
+    let z: Vec<[f64; 6]> = parts.iter().flat_map(|p| p.z.iter().copied()).collect();
     let mut total = parts.swap_remove(0);
+    total.z = z;
     for p in &parts {
         total.energy += p.energy;
         total

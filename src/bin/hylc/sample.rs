@@ -140,12 +140,13 @@ pub fn plan_cmd(write: &Path, reduced: bool, holdout: bool) -> Result<(), String
     Ok(())
 }
 
-/// `hylc scene-plan LOG... --write PLAN [--base B] [--margin M]`.
+/// `hylc scene-plan LOG... --write PLAN [--base B] [--margin M] [--all-triangles]`.
 pub fn scene_plan_cmd(
     logs: &[PathBuf],
     write: &Path,
     base: &str,
     margin: f64,
+    outliers: bool,
 ) -> Result<(), String> {
     use hylc::sample::scene::{scene_plan, StrainExtent};
     if !(margin.is_finite() && margin >= 0.0) {
@@ -154,16 +155,21 @@ pub fn scene_plan_cmd(
     let base_plan = load_plan(base)?;
     let mut ext = StrainExtent::empty();
     for l in logs {
-        StrainExtent::read_log(l, &mut ext)?;
+        StrainExtent::read_log(l, &mut ext, outliers)?;
     }
     let (plan, r) = scene_plan(&base_plan, &ext, margin);
     plan.validate().map_err(|e| format!("scene plan: {e}"))?;
     let text = serde_json::to_string_pretty(&plan).map_err(|e| e.to_string())?;
     std::fs::write(write, text + "\n").map_err(|e| format!("{}: {e}", write.display()))?;
     println!(
-        "{} steps from {} log(s); margin {margin}; base plan {base} ({} samples)",
+        "{} steps from {} log(s), {}; margin {margin}; base plan {base} ({} samples)",
         ext.steps,
         logs.len(),
+        if outliers {
+            "extremes over every triangle"
+        } else {
+            "1st to 99th percentile over the triangles"
+        },
         r.base_samples
     );
     println!(
@@ -181,15 +187,21 @@ pub fn scene_plan_cmd(
         );
     }
     println!(
-        "{}: plan {:016x}, {} samples ({} per 1D range, {}×{} grids on {} pairs): {} fewer solves than the base \
-         plan ({:.1} % of it)",
+        "{}: plan {:016x}, {} samples (1D ranges {}; grids {}): {} fewer solves than the base plan ({:.1} % of it)",
         write.display(),
         plan.hash(),
         plan.len(),
-        plan.count_1d,
-        plan.count_2d,
-        plan.count_2d,
-        plan.pairs.len(),
+        (0..5)
+            .map(|k| plan.n_1d(k).to_string())
+            .collect::<Vec<_>>()
+            .join(", "),
+        (0..plan.pairs.len())
+            .map(|p| {
+                let [a, b] = plan.n_2d(p);
+                format!("{}×{} {a}×{b}", plan.pairs[p][0], plan.pairs[p][1])
+            })
+            .collect::<Vec<_>>()
+            .join(", "),
         r.base_samples - r.samples,
         100.0 * r.samples as f64 / r.base_samples.max(1) as f64
     );
