@@ -50,6 +50,29 @@ pub struct Conformance {
     pub failures: Vec<String>,
 }
 
+impl Conformance {
+    fn new(name: &str, cases: usize) -> Self {
+        Conformance {
+            name: name.to_string(),
+            cases,
+            value: 0.0,
+            first: 0.0,
+            second: 0.0,
+            failures: vec![],
+        }
+    }
+
+    /// Record one case's errors (value, first, second derivative); `failed` gives the line for a failure.
+    fn add(&mut self, e: [f64; 3], tol: [f64; 3], failed: impl FnOnce() -> String) {
+        if e.iter().zip(&tol).any(|(v, t)| v.is_nan() || v > t) {
+            self.failures.push(failed());
+        }
+        self.value = self.value.max(e[0]);
+        self.first = self.first.max(e[1]);
+        self.second = self.second.max(e[2]);
+    }
+}
+
 /// Item 3a for ψ: ψ, ∇ψ, ∇²ψ of each original material against `oracles/psi_oracle.json`; cases beyond `tol`
 /// (value and gradient) or `tol_hess` are listed.
 pub fn psi_conformance(shared: &Path, tol: f64, tol_hess: f64) -> Result<Vec<Conformance>, String> {
@@ -62,14 +85,7 @@ pub fn psi_conformance(shared: &Path, tol: f64, tol_hess: f64) -> Result<Vec<Con
         let samples = oracle["materials"][name]["samples"]
             .as_array()
             .ok_or_else(|| format!("{}: no samples for {name}", path.display()))?;
-        let mut c = Conformance {
-            name: name.to_string(),
-            cases: samples.len(),
-            value: 0.0,
-            first: 0.0,
-            second: 0.0,
-            failures: vec![],
-        };
+        let mut c = Conformance::new(name, samples.len());
         for s in samples {
             let z = nums(&s["z"])?;
             if z.len() != 6 {
@@ -86,15 +102,12 @@ pub fn psi_conformance(shared: &Path, tol: f64, tol_hess: f64) -> Result<Vec<Con
                 rel_norm(&r.grad, &nums(&s["grad"])?),
                 rel_norm(&hv, &nums(&s["hess"])?),
             ];
-            if e.iter().any(|v| v.is_nan()) || e[0] > tol || e[1] > tol || e[2] > tol_hess {
-                c.failures.push(format!(
+            c.add(e, [tol, tol, tol_hess], || {
+                format!(
                     "{name} #{} ({}) z={z:?}: psi {:.2e} grad {:.2e} hess {:.2e}",
                     s["id"], s["kind"], e[0], e[1], e[2]
-                ));
-            }
-            c.value = c.value.max(e[0]);
-            c.first = c.first.max(e[1]);
-            c.second = c.second.max(e[2]);
+                )
+            });
         }
         out.push(c);
     }
@@ -109,14 +122,7 @@ pub fn strain_conformance(shared: &Path, tol: f64) -> Result<Conformance, String
     let cases = oracle["cases"]
         .as_array()
         .ok_or_else(|| format!("{}: no cases", path.display()))?;
-    let mut c = Conformance {
-        name: "strain chain".into(),
-        cases: 2 * cases.len(),
-        value: 0.0,
-        first: 0.0,
-        second: 0.0,
-        failures: vec![],
-    };
+    let mut c = Conformance::new("strain chain", 2 * cases.len());
     for shift in [0.0, 2.0] {
         for case in cases {
             let xloc = nums(&case["xloc"])?;
@@ -165,15 +171,12 @@ pub fn strain_conformance(shared: &Path, tol: f64) -> Result<Conformance, String
                 rel_norm(&jac, &nums(&case["grad"])?),
                 rel_norm(&hess, &nums(&case["hess"])?),
             ];
-            if e.iter().any(|&v| v.is_nan() || v > tol) {
-                c.failures.push(format!(
+            c.add(e, [tol; 3], || {
+                format!(
                     "case {} ({}) shift {shift} m: value {:.2e} jacobian {:.2e} hessian {:.2e}",
                     case["id"], case["kind"], e[0], e[1], e[2]
-                ));
-            }
-            c.value = c.value.max(e[0]);
-            c.first = c.first.max(e[1]);
-            c.second = c.second.max(e[2]);
+                )
+            });
         }
     }
     Ok(c)

@@ -14,17 +14,6 @@ pub fn shared_or_skip(test: &str) -> Option<PathBuf> {
     }
 }
 
-pub fn rel_norm(a: &[f64], b: &[f64]) -> f64 {
-    let d: f64 = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (x - y) * (x - y))
-        .sum::<f64>()
-        .sqrt();
-    let n: f64 = b.iter().map(|y| y * y).sum::<f64>().sqrt();
-    d / n.max(f64::MIN_POSITIVE)
-}
-
 /// Run the `hylc` binary with `args`, assert that it fails with exit code 2 and a one-line message, and return
 /// that message (stderr).
 pub fn cli_error(args: &[&str]) -> String {
