@@ -112,3 +112,37 @@ fn reference_writes_a_pattern_that_loads_and_is_an_equilibrium() {
     assert!(v["steps"].as_u64().unwrap() <= 1, "{v}");
     assert_eq!(p.len(), 40);
 }
+
+/// `solve --quadrature` changes the contact integral (and so Ψ̄ of a pattern in contact), and 0 points is a
+/// one-line error.
+#[test]
+fn solve_quadrature_changes_the_contact_integral() {
+    let err = cli_error(&["solve", "plain", "--quadrature", "0"]);
+    assert!(err.contains("--quadrature"), "{err}");
+    let psi = |q: &str| -> f64 {
+        let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
+            .args([
+                "solve",
+                "plain",
+                "--json",
+                "--z",
+                "0.05,0,0",
+                "--quadrature",
+                q,
+            ])
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        let line = String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .next()
+            .unwrap()
+            .to_string();
+        serde_json::from_str::<serde_json::Value>(&line).unwrap()["psi"]
+            .as_f64()
+            .unwrap()
+    };
+    let (p1, p8) = (psi("1"), psi("8"));
+    assert!(p1.is_finite() && p8.is_finite());
+    assert!((p1 - p8).abs() > 1e-9 * p8.abs(), "{p1} vs {p8}");
+}

@@ -519,6 +519,16 @@ impl Plan {
             let v = obj.get(key).ok_or_else(|| "missing".to_string())?;
             serde_json::from_value(v.clone()).map_err(|e| e.to_string())
         }
+        // an absent or null optional field is None
+        fn optional<T: serde::de::DeserializeOwned>(
+            obj: &serde_json::Map<String, serde_json::Value>,
+            key: &str,
+        ) -> Result<Option<T>, String> {
+            match obj.get(key) {
+                None | Some(serde_json::Value::Null) => Ok(None),
+                Some(_) => field(obj, key).map(Some),
+            }
+        }
         let ranges_obj = obj
             .get("ranges")
             .ok_or_else(|| err("ranges", "missing".into()))?
@@ -547,22 +557,10 @@ impl Plan {
             count_1d: field(obj, "count_1d").map_err(|m| err("count_1d", m))?,
             count_2d: field(obj, "count_2d").map_err(|m| err("count_2d", m))?,
             pairs: field(obj, "pairs").map_err(|m| err("pairs", m))?,
-            ranges_2d: match obj.get("ranges_2d") {
-                None | Some(serde_json::Value::Null) => None,
-                Some(_) => Some(field(obj, "ranges_2d").map_err(|m| err("ranges_2d", m))?),
-            },
-            grid: match obj.get("grid") {
-                None | Some(serde_json::Value::Null) => None,
-                Some(_) => Some(field(obj, "grid").map_err(|m| err("grid", m))?),
-            },
-            counts_1d: match obj.get("counts_1d") {
-                None | Some(serde_json::Value::Null) => None,
-                Some(_) => Some(field(obj, "counts_1d").map_err(|m| err("counts_1d", m))?),
-            },
-            counts_2d: match obj.get("counts_2d") {
-                None | Some(serde_json::Value::Null) => None,
-                Some(_) => Some(field(obj, "counts_2d").map_err(|m| err("counts_2d", m))?),
-            },
+            ranges_2d: optional(obj, "ranges_2d").map_err(|m| err("ranges_2d", m))?,
+            grid: optional(obj, "grid").map_err(|m| err("grid", m))?,
+            counts_1d: optional(obj, "counts_1d").map_err(|m| err("counts_1d", m))?,
+            counts_2d: optional(obj, "counts_2d").map_err(|m| err("counts_2d", m))?,
         };
         plan.validate().map_err(|mut e| {
             e.file = file.map(str::to_string);

@@ -70,6 +70,27 @@ fn report(problem: &MicroProblem, sol: &Solution) -> serde_json::Value {
     })
 }
 
+/// The construction of a pattern argument (it selects C1's tension factors): the flag when given, else knitted
+/// for the generated stockinette and woven for the other generated kinds; a file needs the flag.
+pub fn construction_of(
+    arg: &str,
+    flag: Option<&str>,
+) -> Result<hylc::micro::reference::Construction, String> {
+    use hylc::micro::reference::Construction;
+    match flag {
+        Some("knitted") | Some("knit") => Ok(Construction::Knitted),
+        Some("woven") | Some("weave") => Ok(Construction::Woven),
+        Some(other) => Err(format!(
+            "--construction: expected knitted or woven, got {other:?}"
+        )),
+        None if Path::new(arg).exists() => Err(format!(
+            "{arg}: pass --construction knitted|woven (it selects the tension factors)"
+        )),
+        None if arg == "stockinette" => Ok(Construction::Knitted),
+        None => Ok(Construction::Woven),
+    }
+}
+
 /// `hylc solve`.
 #[allow(clippy::too_many_arguments)]
 pub fn solve(
@@ -241,22 +262,10 @@ pub fn reference(
 ) -> Result<bool, String> {
     use hylc::micro::reference::{reference_state, Construction, ReferenceOptions};
     let p = load_pattern(pattern)?;
-    let construction = match construction {
-        Some("knitted") | Some("knit") => Construction::Knitted,
-        Some("woven") | Some("weave") => Construction::Woven,
-        Some(other) => {
-            return Err(format!(
-                "--construction: expected knitted or woven, got {other:?}"
-            ))
-        }
-        None if equilibrate_only => Construction::Woven,
-        None if Path::new(pattern).exists() => {
-            return Err(format!(
-                "{pattern}: pass --construction knitted|woven (it selects the tension factors)"
-            ))
-        }
-        None if pattern == "stockinette" => Construction::Knitted,
-        None => Construction::Woven,
+    let construction = if equilibrate_only && construction.is_none() {
+        Construction::Woven
+    } else {
+        construction_of(pattern, construction)?
     };
     let (q, report) = reference_state(
         &p,

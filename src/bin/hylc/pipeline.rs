@@ -7,11 +7,11 @@
 //! (`--fresh` starts over).
 
 use crate::fit::{fit, FitArgs};
-use crate::micro::load_pattern;
+use crate::micro::{construction_of, load_pattern};
 use crate::sample::{load_plan, write_meta};
 use crate::simulate::{execute, prepare, snapshot, summary_line, Overrides};
 use hylc::fit::model::{FitOptions, FitReport};
-use hylc::micro::reference::{reference_state, Construction, ReferenceOptions};
+use hylc::micro::reference::{reference_state, ReferenceOptions};
 use hylc::micro::{MicroProblem, SolverOptions};
 use hylc::pattern::Pattern;
 use hylc::rod::YarnMaterial;
@@ -360,21 +360,4 @@ fn run_pattern(args: &RunArgs, arg: &str, log: &mut Log) -> Result<PatternRun, S
         stages,
         summary,
     })
-}
-
-/// The construction of a pattern argument (it selects C1's tension factors): `--construction` when given, else
-/// knitted for the generated stockinette and woven for the other generated kinds; a file needs the flag.
-fn construction_of(arg: &str, flag: Option<&str>) -> Result<Construction, String> {
-    match flag {
-        Some("knitted") | Some("knit") => Ok(Construction::Knitted),
-        Some("woven") | Some("weave") => Ok(Construction::Woven),
-        Some(other) => Err(format!(
-            "--construction: expected knitted or woven, got {other:?}"
-        )),
-        None if Path::new(arg).exists() => Err(format!(
-            "{arg}: pass --construction knitted|woven (it selects the tension factors of the reference state)"
-        )),
-        None if arg == "stockinette" => Ok(Construction::Knitted),
-        None => Ok(Construction::Woven),
-    }
 }
