@@ -10,7 +10,7 @@
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky};
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, Par, Side};
 use nalgebra::{DMatrix, DVector};
 
@@ -25,12 +25,84 @@ pub enum FactorError {
     Other(String),
 }
 
-/// A sparse Cholesky solver that keeps its symbolic analysis across factorisations of matrices with the same
-/// structure.
+/// Patterns up to this order keep a dense n×n slot table (4 bytes per entry); larger ones search each column.
+const DENSE_SLOTS_MAX: usize = 3000;
+
+/// The lower-triangle CSC pattern the solver factorises: sorted rows per column, every diagonal entry present.
+/// It only grows within one solver's life, so a matrix whose entries it covers reuses the symbolic analysis.
+struct LowerPattern {
+    n: usize,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    /// value slot of each diagonal entry
+    diag: Vec<usize>,
+    /// slot + 1 of entry (i, j) at i + n j (0: not in the pattern), for n ≤ [`DENSE_SLOTS_MAX`]
+    slots: Vec<u32>,
+}
+
+impl LowerPattern {
+    /// The pattern with the columns `cols` (row lists, unsorted, duplicates allowed) plus the diagonal.
+    fn new(n: usize, mut cols: Vec<Vec<usize>>) -> Self {
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        let mut row_idx = Vec::new();
+        let mut diag = Vec::with_capacity(n);
+        col_ptr.push(0);
+        for (j, rows) in cols.iter_mut().enumerate() {
+            rows.push(j);
+            rows.sort_unstable();
+            rows.dedup();
+            diag.push(row_idx.len() + rows.binary_search(&j).expect("diagonal pushed"));
+            row_idx.extend_from_slice(rows);
+            col_ptr.push(row_idx.len());
+        }
+        let mut slots = Vec::new();
+        if n <= DENSE_SLOTS_MAX {
+            slots = vec![0u32; n * n];
+            for j in 0..n {
+                for s in col_ptr[j]..col_ptr[j + 1] {
+                    slots[row_idx[s] + n * j] = s as u32 + 1;
+                }
+            }
+        }
+        Self {
+            n,
+            col_ptr,
+            row_idx,
+            diag,
+            slots,
+        }
+    }
+
+    /// The value slot of entry (i, j), if the pattern has it.
+    fn slot(&self, i: usize, j: usize) -> Option<usize> {
+        if self.slots.is_empty() {
+            let (a, b) = (self.col_ptr[j], self.col_ptr[j + 1]);
+            self.row_idx[a..b].binary_search(&i).ok().map(|k| a + k)
+        } else {
+            (self.slots[i + self.n * j] as usize).checked_sub(1)
+        }
+    }
+
+    /// The row lists of the columns.
+    fn columns(&self) -> Vec<Vec<usize>> {
+        (0..self.n)
+            .map(|j| self.row_idx[self.col_ptr[j]..self.col_ptr[j + 1]].to_vec())
+            .collect()
+    }
+}
+
+/// A sparse Cholesky solver that keeps its matrix pattern and symbolic analysis across factorisations. The
+/// pattern is the union of every matrix set since the solver was created (entries missing from a new matrix are
+/// explicit zeros), so contact pairs that come and go cost a symbolic analysis only the first time their blocks
+/// appear.
 #[derive(Default)]
 pub struct KktSolver {
-    symbolic: Option<(Vec<usize>, Vec<usize>, SymbolicCholesky<usize>)>,
+    pattern: Option<(LowerPattern, SymbolicCholesky<usize>)>,
+    /// H in the pattern's value order (duplicates summed), without the shift
+    matrix: Vec<f64>,
     values: Vec<f64>,
+    /// factorisation and solve workspace for up to this many right-hand sides (reset with the pattern)
+    scratch: Option<(usize, MemBuffer)>,
     /// Number of symbolic analyses performed (for the performance report).
     pub analyses: usize,
 }
@@ -63,10 +135,7 @@ impl KktSolver {
         self.solve_refined(n, lower, mu, rhs_list, a, 0)
     }
 
-    /// [`solve_many`](Self::solve_many) followed by `refine` steps of iterative refinement against the
-    /// unshifted H: δ ← δ + solve(b + H δ). Each step shrinks the error of the shift μ by about μ/λ on the
-    /// constraint space (λ the smallest eigenvalue there), so the result tends to the exact constrained solve
-    /// while the factorisation stays regularised (the exact rigid modes are removed by the constraints).
+    /// [`set_matrix`](Self::set_matrix) and [`solve_shifted`](Self::solve_shifted) in one call.
     pub fn solve_refined(
         &mut self,
         n: usize,
@@ -76,52 +145,119 @@ impl KktSolver {
         a: &[Vec<f64>],
         refine: usize,
     ) -> Result<Vec<Vec<f64>>, FactorError> {
-        let mut trip: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(lower.len() + n);
-        trip.extend(lower.iter().map(|&(i, j, v)| Triplet::new(i, j, v)));
-        trip.extend((0..n).map(|i| Triplet::new(i, i, mu)));
-        let mat = SparseColMat::try_new_from_triplets(n, n, &trip)
-            .map_err(|e| FactorError::Other(format!("{e:?}")))?;
-        let sym = mat.symbolic();
-        let same = matches!(&self.symbolic, Some((c, r, _)) if c.as_slice() == sym.col_ptr() && r.as_slice() == sym.row_idx());
-        if !same {
-            let s = factorize_symbolic_cholesky(
-                sym,
-                Side::Lower,
-                Default::default(),
-                Default::default(),
-            )
-            .map_err(|e| FactorError::Other(format!("{e:?}")))?;
-            self.symbolic = Some((sym.col_ptr().to_vec(), sym.row_idx().to_vec(), s));
-            self.analyses += 1;
+        self.set_matrix(n, lower)?;
+        self.solve_shifted(mu, rhs_list, a, refine)
+    }
+
+    /// Store H from its lower-triangle triplets (duplicates summed). The pattern grows (and the symbolic analysis
+    /// is redone) only when `lower` has an entry it lacks, or when n changes.
+    pub fn set_matrix(
+        &mut self,
+        n: usize,
+        lower: &[(usize, usize, f64)],
+    ) -> Result<(), FactorError> {
+        if let Some(&(i, j, _)) = lower.iter().find(|t| t.0 >= n || t.1 > t.0) {
+            return Err(FactorError::Other(format!(
+                "entry ({i}, {j}) is not in the lower triangle of a {n}×{n} matrix"
+            )));
         }
-        let (_, _, symbolic) = self.symbolic.as_ref().expect("set above");
+        // entries the current pattern lacks (all of them when there is none)
+        let mut missing: Vec<(usize, usize)> = Vec::new();
+        let mut cols = match &self.pattern {
+            Some((p, _)) if p.n == n => {
+                self.matrix.clear();
+                self.matrix.resize(p.row_idx.len(), 0.0);
+                for &(i, j, v) in lower {
+                    match p.slot(i, j) {
+                        Some(s) => self.matrix[s] += v,
+                        None => missing.push((i, j)),
+                    }
+                }
+                if missing.is_empty() {
+                    return Ok(());
+                }
+                p.columns()
+            }
+            _ => {
+                missing.extend(lower.iter().map(|&(i, j, _)| (i, j)));
+                vec![Vec::new(); n]
+            }
+        };
+        for (i, j) in missing {
+            cols[j].push(i);
+        }
+        let pattern = LowerPattern::new(n, cols);
+        let sym =
+            SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
+        let symbolic =
+            factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), Default::default())
+                .map_err(|e| FactorError::Other(format!("{e:?}")))?;
+        self.analyses += 1;
+        self.scratch = None;
+        self.matrix.clear();
+        self.matrix.resize(pattern.row_idx.len(), 0.0);
+        for &(i, j, v) in lower {
+            self.matrix[pattern
+                .slot(i, j)
+                .expect("pattern built from these entries")] += v;
+        }
+        self.pattern = Some((pattern, symbolic));
+        Ok(())
+    }
+
+    /// Solve with the stored H (see [`set_matrix`](Self::set_matrix)) shifted by `mu`, followed by `refine` steps
+    /// of iterative refinement against the unshifted H: δ ← δ + solve(b + H δ). Each step shrinks the error of
+    /// the shift μ by about μ/λ on the constraint space (λ the smallest eigenvalue there), so the result tends to
+    /// the exact constrained solve while the factorisation stays regularised (the exact rigid modes are removed
+    /// by the constraints).
+    pub fn solve_shifted(
+        &mut self,
+        mu: f64,
+        rhs_list: &[Vec<f64>],
+        a: &[Vec<f64>],
+        refine: usize,
+    ) -> Result<Vec<Vec<f64>>, FactorError> {
+        let Some((pattern, symbolic)) = self.pattern.as_ref() else {
+            return Err(FactorError::Other("solve before set_matrix".into()));
+        };
+        let n = pattern.n;
+        let mut shifted = self.matrix.clone();
+        for &s in &pattern.diag {
+            shifted[s] += mu;
+        }
+        let sym =
+            SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
+        let mat = SparseColMatRef::new(sym, &shifted);
         self.values.clear();
         self.values.resize(symbolic.len_val(), 0.0);
         let par = Par::Seq;
         let k = rhs_list.len();
         let m = a.len();
-        let mut buf = MemBuffer::new(
-            symbolic
+        let cols = k.max(m).max(1);
+        if !matches!(&self.scratch, Some((c, _)) if *c >= cols) {
+            let req = symbolic
                 .factorize_numeric_llt_scratch::<f64>(par, Default::default())
-                .or(symbolic.solve_in_place_scratch::<f64>(k.max(m).max(1), par)),
-        );
+                .or(symbolic.solve_in_place_scratch::<f64>(cols, par));
+            self.scratch = Some((cols, MemBuffer::new(req)));
+        }
+        let buf = &mut self.scratch.as_mut().expect("set above").1;
         let llt: LltRef<'_, usize, f64> = symbolic
             .factorize_numeric_llt(
                 &mut self.values,
-                mat.as_ref(),
+                mat,
                 Side::Lower,
                 LltRegularization {
                     dynamic_regularization_delta: 0.0,
                     dynamic_regularization_epsilon: 0.0,
                 },
                 par,
-                MemStack::new(&mut buf),
+                MemStack::new(buf),
                 Default::default(),
             )
             .map_err(|_| FactorError::NotPositiveDefinite)?;
         let mut solve_cols = |cols: &[&[f64]]| -> Mat<f64> {
             let mut rhs = Mat::<f64>::from_fn(n, cols.len(), |i, j| cols[j][i]);
-            llt.solve_in_place_with_conj(Conj::No, rhs.as_mut(), par, MemStack::new(&mut buf));
+            llt.solve_in_place_with_conj(Conj::No, rhs.as_mut(), par, MemStack::new(buf));
             rhs
         };
         // X_A = (H+μI)⁻¹ Aᵀ and the Schur complement S = A X_A
@@ -171,10 +307,13 @@ impl KktSolver {
                 .zip(rhs_list)
                 .map(|(d, b)| {
                     let mut r = b.clone();
-                    for &(i, j, v) in lower {
-                        r[i] += v * d[j];
-                        if i != j {
-                            r[j] += v * d[i];
+                    for j in 0..n {
+                        for s in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
+                            let (i, v) = (pattern.row_idx[s], self.matrix[s]);
+                            r[i] += v * d[j];
+                            if i != j {
+                                r[j] += v * d[i];
+                            }
                         }
                     }
                     r
@@ -240,6 +379,40 @@ mod tests {
         // the symbolic analysis is reused for the same structure
         solver.solve(n, &lower, 1.0, &g, &a).unwrap();
         assert_eq!(solver.analyses, 1);
+        // and for a matrix with fewer entries (the missing ones are explicit zeros of the kept pattern)
+        let tridiag_less: Vec<_> = lower
+            .iter()
+            .copied()
+            .filter(|&(i, j, _)| !(i == 3 && j == 2))
+            .collect();
+        let d_less = solver.solve(n, &tridiag_less, 0.0, &g, &a).unwrap();
+        assert_eq!(solver.analyses, 1);
+        // a new entry grows the pattern once; the solve agrees with a fresh solver's
+        let mut more = tridiag_less.clone();
+        more.push((5, 0, 0.5));
+        let d_more = solver.solve(n, &more, 0.0, &g, &a).unwrap();
+        assert_eq!(solver.analyses, 2);
+        solver.solve(n, &more, 0.0, &g, &a).unwrap();
+        assert_eq!(solver.analyses, 2);
+        for (m, want) in [(&tridiag_less, &d_less), (&more, &d_more)] {
+            let fresh = KktSolver::default().solve(n, m, 0.0, &g, &a).unwrap();
+            for i in 0..n {
+                assert!(
+                    (fresh[i] - want[i]).abs() < 1e-13,
+                    "{i}: {} vs {}",
+                    fresh[i],
+                    want[i]
+                );
+            }
+        }
+        // upper-triangle entries are refused with the entry named
+        let err = KktSolver::default()
+            .solve(n, &[(0, 1, 1.0)], 0.0, &g, &a)
+            .unwrap_err();
+        assert!(
+            matches!(&err, FactorError::Other(m) if m.contains("(0, 1)")),
+            "{err:?}"
+        );
         // an indefinite matrix is reported
         let bad: Vec<_> = lower
             .iter()

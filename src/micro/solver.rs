@@ -473,9 +473,8 @@ impl MicroProblem {
         let tc = Instant::now();
         let mut contact_at = tile.home_positions(&state.y);
         tile.update_contacts(&contact_at, margin)?;
-        // contact pairs that have been within reach since the last candidate update: their blocks stay in the
-        // matrix structure (as explicit zeros when inactive), so the symbolic analysis is reused
-        let mut ever_active = vec![false; tile.contacts.len()];
+        // the KKT solver's pattern is the union of every matrix of this solve: the rod blocks from the start,
+        // each contact pair's blocks from the first step it is active, so the symbolic analysis is reused
         let rod_structure = rod_structure(&tile);
         timings.contact += tc.elapsed().as_secs_f64();
 
@@ -540,8 +539,9 @@ impl MicroProblem {
                 .filter(|&&(i, j, _)| i >= j)
                 .map(|&(i, j, v)| (i, j, v * scale(i) * scale(j)))
                 .collect();
-            lower.extend_from_slice(&rod_structure);
-            contact_structure(&tile, &state.y, &mut ever_active, &mut lower);
+            if steps == 0 {
+                lower.extend_from_slice(&rod_structure);
+            }
             let diag_max = lower
                 .iter()
                 .filter(|t| t.0 == t.1)
@@ -555,18 +555,12 @@ impl MicroProblem {
             let mu_floor = 1e-10 * diag_max;
             mu = mu.max(mu_floor);
             let mut delta = None;
+            kkt.set_matrix(nd, &lower).map_err(MicroError::Linear)?;
             for _ in 0..40 {
                 // at the floor, two refinement steps remove the shift's effect on soft modes (exact Newton)
                 let refine = if mu <= mu_floor { 2 } else { 0 };
                 let solved = kkt
-                    .solve_refined(
-                        nd,
-                        &lower,
-                        mu,
-                        std::slice::from_ref(&g),
-                        &self.constraints,
-                        refine,
-                    )
+                    .solve_shifted(mu, std::slice::from_ref(&g), &self.constraints, refine)
                     .map(|mut v| v.pop().expect("one right-hand side"));
                 match solved {
                     Ok(d) if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 => {
@@ -623,7 +617,6 @@ impl MicroProblem {
                     let tc = Instant::now();
                     if tile.update_contacts(&positions, margin).is_ok() {
                         contact_at = positions.clone();
-                        ever_active = vec![false; tile.contacts.len()];
                     }
                     timings.contact += tc.elapsed().as_secs_f64();
                 }
@@ -692,35 +685,6 @@ fn rod_structure(tile: &Tile) -> Vec<(usize, usize, f64)> {
         push_all(&dofs);
     }
     out
-}
-
-/// Mark the contact candidates within reach at `y` and add explicit zeros for the blocks of every pair marked
-/// since the last candidate update.
-fn contact_structure(
-    tile: &Tile,
-    y: &[f64],
-    ever_active: &mut [bool],
-    lower: &mut Vec<(usize, usize, f64)>,
-) {
-    let reach = 2.0 * tile.contact_radius;
-    for (k, pair) in tile.contacts.iter().enumerate() {
-        let pts = pair.points(tile);
-        if !ever_active[k] {
-            let x = pts.map(|(v, o)| tile.position(y, v, o));
-            let (d2, _, _) = crate::contact::segment_distance_squared(&x[0], &x[1], &x[2], &x[3]);
-            ever_active[k] = d2 < reach * reach * 1.0001;
-        }
-        if ever_active[k] {
-            let dofs: Vec<usize> = pts.iter().flat_map(|&(v, _)| 3 * v..3 * v + 3).collect();
-            for &a in &dofs {
-                for &b in &dofs {
-                    if a >= b {
-                        lower.push((a, b, 0.0));
-                    }
-                }
-            }
-        }
-    }
 }
 
 /// ũ_v from the dof vector.

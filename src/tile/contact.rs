@@ -47,33 +47,39 @@ pub(super) fn assemble(
         tile.contact_radius,
         m.contact_quadrature,
     )?;
-    let locals: Vec<Result<super::Local<12>, ContactError>> = tile
+    // pairs beyond the cutoff contribute nothing: only the others carry a (large) local block
+    let locals: Vec<Result<Option<super::Local<12>>, ContactError>> = tile
         .contacts
         .par_iter()
         .map(|pair| {
             let pts = pair.points(tile);
             let x: [Vector3<f64>; 4] = pts.map(|(v, o)| tile.position(y, v, o));
+            if kernel.beyond_cutoff(&x) {
+                return Ok(None);
+            }
             let la = tile.pattern.edges[pair.a].rest_length;
             let lb = tile.pattern.edges[pair.b].rest_length;
             if want == Want::Value {
-                Ok(super::Local {
+                Ok(Some(super::Local {
                     value: kernel.value(&x, la, lb)?,
                     g: Default::default(),
                     h: Default::default(),
-                })
+                }))
             } else {
                 let r = kernel.value_gradient_hessian(&x, la, lb)?;
-                Ok(super::Local {
+                Ok(Some(super::Local {
                     value: r.value,
                     g: r.gradient,
                     h: r.hessian,
-                })
+                }))
             }
         })
         .collect();
     let mut total = 0.0;
     for (pair, l) in tile.contacts.iter().zip(locals) {
-        let l = l?;
+        let Some(l) = l? else {
+            continue;
+        };
         if l.value == 0.0 && want == Want::Value {
             continue;
         }

@@ -232,7 +232,9 @@ impl<'a> Tile<'a> {
         let ks = self.material.stretch_stiffness() * terms.stretch;
         let mut parts = EnergyParts::default();
         let mut grad = (want != Want::Value).then(|| DVector::zeros(4 * n));
-        let mut trip: Option<Vec<(usize, usize, f64)>> = (want == Want::Hessian).then(Vec::new);
+        // 6² + 11² lower-and-upper entries per vertex for the rods, 12² per contact pair
+        let mut trip: Option<Vec<(usize, usize, f64)>> = (want == Want::Hessian)
+            .then(|| Vec::with_capacity(157 * n + 144 * self.contacts.len()));
 
         // stretching, one stencil per edge
         if terms.stretch != 0.0 {
