@@ -6,7 +6,7 @@
 # out (never fitted, only predicted). Then `hylc fit` against the original material (`--compare`).
 # Writes validation/fit/<pattern>.{jsonl,meta.json,material.json,fit.json,plots/} and prints the tables.
 #
-#   cargo build --release && validation/fit_originals.sh            # all five (about 85 min on 2 cores, rib 61 min)
+#   cargo build --release && validation/fit_originals.sh            # all five (the four other than basket: 81 min on 2 cores, 61 of them rib)
 #   validation/fit_originals.sh basket satin                        # some of them
 #   PLAN=_1d validation/fit_originals.sh                            # the 1D ranges only (plans/<pattern>_1d.json)
 #
