@@ -7,12 +7,13 @@
 //! query and refit + query with the 3 × 3 flat images, and the brute-force reference.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use hylc::checks::contact::PairCheck;
 use hylc::contact::broad::synthetic_weave;
-use hylc::contact::checks::PairCheck;
 use hylc::contact::{
-    brute_force_candidates, tile_segments, BroadPhase, PairKernel, SegmentTopology, TileImages,
+    brute_force_candidates, tile_segments, BroadPhase, PairKernel, SegmentTopology,
 };
 use hylc::diff::reference_ad;
+use hylc::periodic::TileImages;
 use nalgebra::Vector3;
 use std::hint::black_box;
 

@@ -3,8 +3,8 @@
 //! automatic differentiation of the generic reference implementation.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use hylc::checks::material::PsiCheck;
 use hylc::diff::{reference_ad, Differentiable};
-use hylc::material::checks::PsiCheck;
 use hylc::material::synthetic::default_material;
 use hylc::material::Material;
 use std::hint::black_box;

@@ -5,9 +5,9 @@
 //! the file's disagree).
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use hylc::generate::default_pattern;
 use hylc::micro::linear::KktSolver;
 use hylc::micro::{Elimination, MacroStrain, MicroProblem, SolverOptions};
-use hylc::pattern::generate::default_pattern;
 use hylc::pattern::Pattern;
 use hylc::rod::YarnMaterial;
 use hylc::tile::{Terms, Want};

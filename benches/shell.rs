@@ -8,9 +8,9 @@
 //!   assembly alone.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use hylc::checks::shell::sample_stencil;
 use hylc::material::synthetic::default_material;
 use hylc::material::Material;
-use hylc::shell::checks::sample_stencil;
 use hylc::shell::solver::{Boundary, Settings, Simulation};
 use hylc::shell::{ElementModel, Mesh, ModelFlags, Psd};
 use rand::SeedableRng;

@@ -8,7 +8,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hylc::diff::{reference_ad, Differentiable};
-use hylc::pattern::generate::{stockinette, weave, KnitParams, WeaveParams};
+use hylc::generate::{stockinette, weave, KnitParams, WeaveParams};
 use hylc::pattern::Pattern;
 use hylc::rod::bend_twist::{bend_twist_value, bend_twist_vgh, BendTwistParams, StencilFrames};
 use hylc::rod::frame::reference_twist_raw;

@@ -6,7 +6,7 @@
 //! configurations for the monotonicity test. Comparisons use the harness form ‖a − b‖ ≤ tol (‖b‖ + scale) with
 //! the scales of `hylc::contact::checks` (V = k_c l̄_a l̄_b, V/r, V/r²).
 
-use hylc::contact::checks::{random_rotation, sample_pair, PAIR_CATEGORIES};
+use hylc::checks::contact::{random_rotation, sample_pair, PAIR_CATEGORIES};
 use hylc::contact::{PairKernel, PairVgh};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use proptest::prelude::*;

@@ -8,11 +8,11 @@
 //!
 //! The pattern is the embedded plain weave after Algorithm C1 (computed once).
 
+use hylc::generate::default_pattern;
 use hylc::micro::elimination::stencil_copies;
 use hylc::micro::reference::{reference_state, Construction, ReferenceOptions};
 use hylc::micro::surface::SurfaceMap;
 use hylc::micro::{Elimination, MacroStrain, MicroProblem, SolverOptions, Status};
-use hylc::pattern::generate::default_pattern;
 use hylc::pattern::Pattern;
 use hylc::rod::YarnMaterial;
 use nalgebra::Vector3;

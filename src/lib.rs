@@ -1,19 +1,37 @@
 //! hylc — homogenized yarn-level cloth.
 //!
-//! Stages follow the data flow of `../shared/design/01-architecture.md`: the derivative harness ([`diff`]) and the
-//! spline material ψ(z) ([`material`]) come first; the yarn model, micro solver, fitting and cloth solver build on
-//! them.
+//! Stages follow the data flow of `../shared/design/01-architecture.md`. Layers import downwards only (a test,
+//! `tests/layers.rs`, fails on an import against this order); each group below may use the groups above it:
+//!
+//! 1. foundations: [`real`] (the scalar type of the reference implementations, generic 3-vector operations),
+//!    [`periodic`] (tile offsets, transforms and images), [`diff`] (the derivative harness);
+//! 2. data: [`material`] (the spline energy density ψ(z)), [`pattern`] (yarn topology, `.pyp` files);
+//! 3. yarn mechanics: [`rod`], [`contact`], [`tile`], [`micro`];
+//! 4. homogenization: [`sample`], [`fit`];
+//! 5. cloth: [`shell`];
+//! 6. on top: [`generate`] (pattern generators), [`validate`] (conformance against the original data),
+//!    [`checks`] (every energy registered with the harness).
 
-pub mod contact;
+// 1. foundations
 pub mod diff;
-pub mod fit;
+pub mod periodic;
+pub mod real;
+// 2. data
 pub mod material;
-pub mod micro;
 pub mod pattern;
+// 3. yarn mechanics
+pub mod contact;
+pub mod micro;
 pub mod rod;
-pub mod sample;
-pub mod shell;
 pub mod tile;
+// 4. homogenization
+pub mod fit;
+pub mod sample;
+// 5. cloth
+pub mod shell;
+// 6. on top
+pub mod checks;
+pub mod generate;
 pub mod validate;
 
 use std::path::PathBuf;

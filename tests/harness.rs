@@ -1,8 +1,9 @@
 //! The derivative harness itself: every registered function passes at the policy's tolerances, and deliberately
 //! wrong derivatives (test-only mutants of real bugs) are caught.
 
-use hylc::diff::{check_function, run_all, CheckConfig, Differentiable, Real, Vgh};
-use hylc::material::checks::{sample_strain, test_spline1d, PsiCheck};
+use hylc::checks::material::{sample_strain, test_spline1d, PsiCheck};
+use hylc::checks::run_all;
+use hylc::diff::{check_function, CheckConfig, Differentiable, Real, Vgh};
 use hylc::material::synthetic::default_material;
 use hylc::material::Hermite1D;
 use nalgebra::{DMatrix, DVector};

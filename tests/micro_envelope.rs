@@ -1,9 +1,9 @@
 //! Envelope-theorem derivatives of Ψ̄ against central differences of complete re-solves (`06-verification.md`,
 //! section 1: tolerance 1e-4 relative), on the generated plain weave (no external data needed).
 
+use hylc::generate::default_pattern;
 use hylc::micro::envelope::{parameter_derivatives, strain_derivatives, PARAMETER_NAMES};
 use hylc::micro::{MacroStrain, MicroProblem, SolverOptions, Status};
-use hylc::pattern::generate::default_pattern;
 use hylc::rod::YarnMaterial;
 
 fn problem(material: &YarnMaterial) -> MicroProblem {

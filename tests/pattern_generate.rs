@@ -2,7 +2,7 @@
 //! frames, rest state, sampling, distances between centre lines, smoothness across the tile boundary,
 //! determinism, parameter errors, OBJ export and the `hylc generate` command.
 
-use hylc::pattern::generate::{
+use hylc::generate::{
     default_pattern, min_centerline_distance, segment_distance, stockinette, to_obj, weave,
     GenerateError, KnitParams, SameYarn, WeaveParams, DEFAULT_KINDS,
 };

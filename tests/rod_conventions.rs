@@ -10,8 +10,9 @@
 mod common;
 
 use hylc::pattern::Pattern;
+use hylc::periodic::Translation;
 use hylc::rod::frame::angle_diff;
-use hylc::rod::{raw_reference_twists, RodState, RodTopology, Translation};
+use hylc::rod::{raw_reference_twists, RodState, RodTopology};
 
 const NAMES: [&str; 5] = [
     "basket",

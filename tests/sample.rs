@@ -5,8 +5,8 @@
 mod common;
 
 use common::cli_error;
+use hylc::generate::default_pattern;
 use hylc::micro::{MicroProblem, SolverOptions};
-use hylc::pattern::generate::default_pattern;
 use hylc::rod::YarnMaterial;
 use hylc::sample::{merge, read_samples, run_plan, Plan, Record, RunOptions};
 use std::collections::BTreeMap;

@@ -399,8 +399,8 @@ fn builtin_scenes_round_trip_and_a_short_run_is_stable() {
 /// error in the weighted Hessian.
 #[test]
 fn harness_catches_strain_chain_mutants() {
+    use hylc::checks::shell::StrainCheck;
     use hylc::diff::{check_function, CheckConfig, Differentiable, Real, Vgh};
-    use hylc::shell::checks::StrainCheck;
     struct Mutant(usize);
     impl Differentiable for Mutant {
         fn name(&self) -> String {

@@ -3,7 +3,7 @@
 
 mod common;
 
-use hylc::pattern::generate::{weave, WeaveParams};
+use hylc::generate::{weave, WeaveParams};
 use hylc::pattern::Pattern;
 use hylc::rod::{RodState, YarnMaterial};
 use hylc::tile::calibration::{

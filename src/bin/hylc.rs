@@ -18,13 +18,14 @@ mod simulate;
 mod validate;
 
 use clap::{Parser, Subcommand};
-use hylc::diff::{format_table, run_all, CheckConfig};
-use hylc::material::synthetic::default_material;
-use hylc::material::{Material, PsiVgh, STRAIN_NAMES};
-use hylc::pattern::generate::{
+use hylc::checks::run_all;
+use hylc::diff::{format_table, CheckConfig};
+use hylc::generate::{
     min_centerline_distance, stockinette, to_obj, weave, KnitParams, SameYarn, WeaveParams,
     DEFAULT_KINDS,
 };
+use hylc::material::synthetic::default_material;
+use hylc::material::{Material, PsiVgh, STRAIN_NAMES};
 use hylc::pattern::Pattern;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

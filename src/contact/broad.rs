@@ -44,142 +44,14 @@
 
 use super::{segment_distance_squared, ContactError};
 use crate::pattern::{Edge, Pattern};
-use nalgebra::{Matrix3, Vector3};
+use crate::periodic::{is_positive, TileImage, TileImages};
+use nalgebra::Vector3;
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector as PVector;
 use parry3d_f64::partitioning::{Bvh, BvhBuildStrategy, BvhWorkspace};
 
 /// A segment given by its two world endpoints (start, end).
 pub type Segment = [Vector3<f64>; 2];
-
-/// One periodic copy of the tile: the rigid motion x ↦ R x + t that maps the tile onto its copy at offset
-/// (dx, dy) (`03-homogenization.md`: φ(ξ + (dx p₁, dy p₂)) = T φ(ξ)).
-#[derive(Clone, Debug, PartialEq)]
-pub struct TileImage {
-    /// Periodic offset (dx, dy) of the copy.
-    pub offset: [i32; 2],
-    /// Rotation R (orthonormal, det +1).
-    pub rotation: Matrix3<f64>,
-    /// Translation t.
-    pub translation: Vector3<f64>,
-}
-
-impl TileImage {
-    /// The home tile (offset (0, 0), identity).
-    pub fn identity() -> Self {
-        TileImage {
-            offset: [0, 0],
-            rotation: Matrix3::identity(),
-            translation: Vector3::zeros(),
-        }
-    }
-
-    /// The flat copy at `offset`: a translation by (dx p₁, dy p₂, 0).
-    pub fn flat(offset: [i32; 2], periods: [f64; 2]) -> Self {
-        TileImage {
-            offset,
-            rotation: Matrix3::identity(),
-            translation: Vector3::new(
-                offset[0] as f64 * periods[0],
-                offset[1] as f64 * periods[1],
-                0.0,
-            ),
-        }
-    }
-
-    /// T(x) = R x + t.
-    #[inline]
-    pub fn apply(&self, x: &Vector3<f64>) -> Vector3<f64> {
-        self.rotation * x + self.translation
-    }
-}
-
-/// True for the positive half of the offset lattice (dy > 0, or dy = 0 and dx > 0).
-fn is_positive(o: [i32; 2]) -> bool {
-    o[1] > 0 || (o[1] == 0 && o[0] > 0)
-}
-
-/// The home tile and its periodic images; index 0 is always the home (offset (0, 0), identity). Closed under
-/// o ↦ −o.
-#[derive(Clone, Debug, PartialEq)]
-pub struct TileImages {
-    images: Vec<TileImage>,
-}
-
-impl TileImages {
-    /// Checks and orders a list of tile images: offsets distinct, the home offset (0, 0) present with the identity
-    /// transform, every offset's negative present, rotations orthonormal to 1e-9. The home moves to index 0, the
-    /// others keep their order.
-    pub fn new(images: Vec<TileImage>) -> Result<Self, ContactError> {
-        let bad = |m: String| Err(ContactError::InvalidParameter(m));
-        for (i, a) in images.iter().enumerate() {
-            if images[..i].iter().any(|b| b.offset == a.offset) {
-                return bad(format!("duplicate tile image offset {:?}", a.offset));
-            }
-            let neg = [-a.offset[0], -a.offset[1]];
-            if !images.iter().any(|b| b.offset == neg) {
-                return Err(ContactError::MissingImage { offset: neg });
-            }
-            let orth = (a.rotation.transpose() * a.rotation - Matrix3::identity()).norm();
-            let rigid = orth <= 1e-9
-                && a.rotation.determinant() > 0.0
-                && a.translation.iter().all(|v| v.is_finite());
-            if !rigid {
-                return bad(format!("tile image {:?} is not a rigid motion", a.offset));
-            }
-        }
-        let Some(home) = images.iter().position(|a| a.offset == [0, 0]) else {
-            return Err(ContactError::MissingImage { offset: [0, 0] });
-        };
-        if images[home] != TileImage::identity() {
-            return bad("the home tile image (0, 0) must be the identity".into());
-        }
-        let mut ordered = vec![images[home].clone()];
-        ordered.extend(
-            images
-                .into_iter()
-                .enumerate()
-                .filter(|(i, _)| *i != home)
-                .map(|(_, a)| a),
-        );
-        Ok(TileImages { images: ordered })
-    }
-
-    /// The home and its 8 neighbours of a flat tile with periods (p₁, p₂) (zero macro strain): translations by
-    /// (dx p₁, dy p₂, 0), dx, dy ∈ {−1, 0, 1}.
-    pub fn flat(periods: [f64; 2]) -> Self {
-        let mut v = vec![TileImage::identity()];
-        for dy in -1..=1 {
-            for dx in -1..=1 {
-                if (dx, dy) != (0, 0) {
-                    v.push(TileImage::flat([dx, dy], periods));
-                }
-            }
-        }
-        TileImages { images: v }
-    }
-
-    pub fn len(&self) -> usize {
-        self.images.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.images.is_empty()
-    }
-
-    pub fn get(&self, k: usize) -> &TileImage {
-        &self.images[k]
-    }
-
-    pub fn iter(&self) -> std::slice::Iter<'_, TileImage> {
-        self.images.iter()
-    }
-
-    /// Index of the image with this offset.
-    pub fn index_of(&self, offset: [i32; 2]) -> Option<usize> {
-        self.images.iter().position(|a| a.offset == offset)
-    }
-}
 
 /// World segments of a tile: segment i runs from `positions[i]` to the image of `positions[end]` under the tile
 /// transform of the edge's offset (at zero strain: `positions[end] + (dx p₁, dy p₂, 0)`).
@@ -854,38 +726,5 @@ mod tests {
             .iter()
             .any(|c| c.a == c.b && images.get(c.image).offset == [0, 1]));
         assert!(!c.iter().any(|c| c.a == c.b && c.image == 0));
-    }
-
-    #[test]
-    fn images_are_validated() {
-        let per = [1.0, 2.0];
-        let mut v: Vec<TileImage> = TileImages::flat(per).iter().cloned().collect();
-        assert!(TileImages::new(v.clone()).is_ok());
-        v.retain(|im| im.offset != [-1, 0]);
-        assert_eq!(
-            TileImages::new(v.clone()),
-            Err(ContactError::MissingImage { offset: [-1, 0] })
-        );
-        let w = vec![TileImage::flat([1, 0], per), TileImage::flat([-1, 0], per)];
-        assert_eq!(
-            TileImages::new(w),
-            Err(ContactError::MissingImage { offset: [0, 0] })
-        );
-        let mut s = vec![
-            TileImage::identity(),
-            TileImage::flat([1, 0], per),
-            TileImage::flat([-1, 0], per),
-        ];
-        s[1].rotation *= 2.0;
-        assert!(TileImages::new(s).is_err());
-        // home moves to the front
-        let t = TileImages::new(vec![
-            TileImage::flat([1, 0], per),
-            TileImage::identity(),
-            TileImage::flat([-1, 0], per),
-        ])
-        .unwrap();
-        assert_eq!(t.get(0).offset, [0, 0]);
-        assert_eq!(t.index_of([-1, 0]), Some(2));
     }
 }

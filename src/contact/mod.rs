@@ -14,14 +14,11 @@
 //! non-finite number.
 
 pub mod broad;
-pub mod checks;
 pub mod pair;
 
 pub use broad::{
     brute_force_candidates, tile_segments, BroadPhase, CandidatePair, Segment, SegmentTopology,
-    TileImage, TileImages,
 };
-pub use checks::diff_checks;
 pub use pair::{pair_energy_reference, PairKernel, PairVgh};
 
 use nalgebra::Vector3;
@@ -65,6 +62,17 @@ impl fmt::Display for ContactError {
 }
 
 impl std::error::Error for ContactError {}
+
+impl From<crate::periodic::PeriodicError> for ContactError {
+    fn from(e: crate::periodic::PeriodicError) -> Self {
+        match e {
+            crate::periodic::PeriodicError::Invalid(m) => ContactError::InvalidParameter(m),
+            crate::periodic::PeriodicError::MissingImage { offset } => {
+                ContactError::MissingImage { offset }
+            }
+        }
+    }
+}
 
 /// Gauss–Legendre quadrature of order Q on [0, 1]: Q nodes in increasing order and their weights (summing to 1).
 /// Exact for polynomials of degree ≤ 2Q − 1.

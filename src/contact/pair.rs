@@ -19,7 +19,7 @@
 //! zero and the kernels return zeros without visiting the quadrature pairs.
 
 use super::{segment_distance_squared, ContactError, GaussLegendre, RHO_MIN};
-use crate::diff::Real;
+use crate::real::Real;
 use crate::rod::YarnMaterial;
 use nalgebra::{SMatrix, SVector, Vector3};
 

@@ -5,9 +5,9 @@
 //!    generic over the scalar type, and
 //! 2. central finite differences (Richardson-extrapolated) of the fast implementation itself.
 //!
-//! Registering a new energy means implementing one trait, [`Differentiable`], and adding one line to
-//! [`registry`]. The CLI command `check-derivatives` runs every registered function and exits non-zero on any
-//! failure; CI runs it.
+//! Registering a new energy means implementing one trait, [`Differentiable`], and adding one line to the
+//! registry in `src/checks/`. The CLI command `check-derivatives` runs every registered function and exits
+//! non-zero on any failure; CI runs it.
 //!
 //! Tolerance policy (relative, normwise): a comparison of a computed quantity `a` against a trusted one `b` passes
 //! when `‖a − b‖ ≤ tol · (‖b‖ + scale)`, with `‖·‖` the Euclidean (vector) or Frobenius (matrix) norm and `scale` a
@@ -20,20 +20,12 @@ pub use fd::{fd_gradient, fd_hessian};
 pub use report::{format_table, Report};
 
 use nalgebra::{DMatrix, DVector};
-use num_dual::{Dual2DVec64, DualNum};
+use num_dual::Dual2DVec64;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-/// Scalar types the reference implementations are written for: `f64` and num-dual numbers over `f64`.
-pub trait Real: DualNum<Primitive = f64> {}
-impl<T: DualNum<Primitive = f64>> Real for T {}
-
-/// Shorthand to build a constant of a generic scalar type.
-#[inline]
-pub fn c<D: Real>(x: f64) -> D {
-    D::from(x)
-}
+pub use crate::real::{c, Real};
 
 /// The tolerances of `06-verification.md`, section 1 (relative, normwise).
 #[derive(Clone, Copy, Debug)]
@@ -326,21 +318,9 @@ fn fxhash(s: &str) -> u64 {
     })
 }
 
-/// Every function the project puts under the harness. Later stages add their rows here.
-pub fn registry() -> Vec<Box<dyn Check>> {
-    let mut checks: Vec<Box<dyn Check>> = Vec::new();
-    checks.extend(crate::material::diff_checks());
-    checks.extend(crate::rod::diff_checks());
-    checks.extend(crate::contact::diff_checks());
-    checks.extend(crate::tile::diff_checks());
-    checks.extend(crate::micro::diff_checks());
-    checks.extend(crate::shell::diff_checks());
+/// Run every check of `checks` whose name contains `filter` (all when empty).
+pub fn run_checks(checks: &[Box<dyn Check>], cfg: &CheckConfig, filter: &str) -> Vec<Report> {
     checks
-}
-
-/// Run every registered check whose name contains `filter` (all when empty).
-pub fn run_all(cfg: &CheckConfig, filter: &str) -> Vec<Report> {
-    registry()
         .iter()
         .filter(|c| filter.is_empty() || c.name().contains(filter))
         .map(|c| c.check(cfg))

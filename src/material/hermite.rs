@@ -10,7 +10,7 @@
 //! Fast evaluation uses power-basis coefficients precomputed per piece. The generic reference implementation
 //! ([`basis_weights`]) evaluates the Hermite basis functions directly from the stored knots, values and slopes.
 
-use crate::diff::Real;
+use crate::real::Real;
 
 /// Hermite basis in the local coordinate s ∈ [0, 1] of a cell, as power-basis coefficients (rows: weights of
 /// pᵢ, pᵢ₊₁, h·mᵢ, h·mᵢ₊₁; columns: s⁰..s³).

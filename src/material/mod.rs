@@ -9,17 +9,15 @@
 //! with the matrix functions in divided-difference form ([`spectral`]). [`Material::eval`] is the fast path
 //! (value, gradient, Hessian), [`Material::reference`] its generic twin for the derivative harness.
 
-pub mod checks;
 pub mod hermite;
 pub mod json;
 pub mod spectral;
 pub mod synthetic;
 
-pub use checks::diff_checks;
 pub use hermite::{Hermite1D, Hermite2D};
 pub use json::MaterialError;
 
-use crate::diff::Real;
+use crate::real::Real;
 use hermite::{basis_piece, basis_weights, piece_from_index};
 use spectral::{spectral_00, spectral_00_reference};
 

@@ -18,7 +18,7 @@
 //! u = z_k/σ_k. Derivatives are taken with respect to w = (u, m, δ, b); the caller maps them to z.
 
 use super::hermite::{Derivs2, Hermite1D};
-use crate::diff::Real;
+use crate::real::Real;
 
 /// Below this eigenvalue half-gap (in units of the spline's knot coordinate) two eigenvalues on different pieces
 /// are treated with the polynomial of the piece containing their mean: the error is at most the jump of f″ times

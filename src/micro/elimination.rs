@@ -11,7 +11,7 @@
 use super::strain::{Family, MacroStrain, StrainError};
 use super::surface::SurfaceMap;
 use crate::pattern::Pattern;
-use crate::rod::TileTransforms;
+use crate::periodic::TileTransforms;
 use crate::tile::{DofMap, Tile};
 use nalgebra::{Matrix3, Vector3};
 use std::collections::BTreeSet;
@@ -135,7 +135,7 @@ pub fn stencil_copies(tile: &Tile) -> Vec<(usize, [i32; 2])> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pattern::generate::default_pattern;
+    use crate::generate::default_pattern;
 
     #[test]
     fn zero_strain_and_zero_displacement_reproduce_the_reference() {

@@ -5,7 +5,6 @@
 //! constrained linear system ([`linear`]) finds the equilibrium; [`envelope`] turns it into Ψ̄ and its
 //! derivatives.
 
-mod checks;
 pub mod elimination;
 pub mod envelope;
 pub mod grid;
@@ -15,7 +14,6 @@ pub mod solver;
 pub mod strain;
 pub mod surface;
 
-pub use checks::diff_checks;
 pub use elimination::Elimination;
 pub use solver::{MicroError, MicroProblem, MicroState, Solution, SolverOptions, Status};
 pub use strain::{Family, MacroStrain, StrainError};

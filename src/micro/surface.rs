@@ -12,8 +12,8 @@
 //! harness can differentiate through the map; sinc uses its Taylor series near 0, so k → 0 is smooth.
 
 use super::strain::{Family, MacroStrain};
-use crate::diff::Real;
-use crate::rod::TileTransforms;
+use crate::periodic::TileTransforms;
+use crate::real::Real;
 use nalgebra::{Matrix3, Vector3};
 
 /// sinc(x) = sin(x)/x, by its series for |x| < 1e-2 (truncation below 1e-21).

@@ -10,8 +10,6 @@
 //! of vertex `i` belong to that outgoing edge; rest curvature, rest twist and reference twist belong to the bending
 //! stencil centred at vertex `i` (incoming edge, vertex, outgoing edge).
 
-pub mod generate;
-
 use nalgebra::Vector3;
 
 pub mod pyp;

@@ -15,9 +15,9 @@ use super::frame::{
     continuous_twist, curvature_binormal, curvature_binormal_jet, edge_frame, reference_twist_raw,
     transport,
 };
-use super::generic::{self as g, V3};
+use super::generic::transport_generic;
 use super::jet::{Jet, VJet};
-use crate::diff::Real;
+use crate::real::{self as g, Real, V3};
 use nalgebra::{SMatrix, SVector, Vector3};
 
 /// The stored state of one stencil: unit tangents and reference directors of its two edges at the last accepted
@@ -280,8 +280,8 @@ pub fn bend_twist_reference<D: Real>(x: &[D], fr: &StencilFrames, p: &BendTwistP
     let (l0, l1) = (g::norm(&e0), g::norm(&e1));
     let t0 = g::scale(&e0, &l0.recip());
     let t1 = g::scale(&e1, &l1.recip());
-    let u0 = g::transport(&g::from_f64(&fr.t0), &t0, &g::from_f64(&fr.u0));
-    let u1 = g::transport(&g::from_f64(&fr.t1), &t1, &g::from_f64(&fr.u1));
+    let u0 = transport_generic(&g::from_f64(&fr.t0), &t0, &g::from_f64(&fr.u0));
+    let u1 = transport_generic(&g::from_f64(&fr.t1), &t1, &g::from_f64(&fr.u1));
     let v0 = g::cross(&t0, &u0);
     let v1 = g::cross(&t1, &u1);
     let frame = |u: &V3<D>, v: &V3<D>, th: &D| {
@@ -298,7 +298,7 @@ pub fn bend_twist_reference<D: Real>(x: &[D], fr: &StencilFrames, p: &BendTwistP
     );
     let k1 = g::dot(&kb, &g::add(&m20, &m21)) * 0.5;
     let k2 = g::dot(&kb, &g::add(&m10, &m11)) * (-0.5);
-    let pu0 = g::transport(&t0, &t1, &u0);
+    let pu0 = transport_generic(&t0, &t1, &u0);
     let raw = g::dot(&g::cross(&pu0, &u1), &t1).atan2(g::dot(&pu0, &u1));
     let tau = raw.clone() + (continuous_twist(fr.twist, fr.twist_raw, raw.re()) - raw.re());
     let m = th1 - th0 + tau;

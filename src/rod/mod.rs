@@ -2,7 +2,6 @@
 //! 2010): frames, parallel transport, reference twist, and the stretching and bending+twisting stencils.
 
 pub mod bend_twist;
-mod checks;
 pub mod frame;
 pub mod generic;
 pub mod jet;
@@ -11,9 +10,5 @@ pub mod state;
 pub mod stretch;
 
 pub use bend_twist::{BendTwistParams, StencilFrames};
-pub use checks::diff_checks;
 pub use material::YarnMaterial;
-pub use state::{
-    raw_reference_twists, set_rest_to_current, Placement, RodState, RodTopology, StencilDofs,
-    TileTransforms, Translation, MAX_OFFSET,
-};
+pub use state::{raw_reference_twists, set_rest_to_current, RodState, RodTopology, StencilDofs};

@@ -1,8 +1,8 @@
 //! Stretching stencil (`02-yarn-model.md`, "Energies"): E_s = ½ k_s l̄ (l/l̄ − 1)² for one edge, 6 dofs
 //! (x_start, x_end).
 
-use super::generic::{norm, sub, v3};
-use crate::diff::Real;
+use crate::real::Real;
+use crate::real::{norm, sub, v3};
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 
 /// Stretching energy of one edge (fast value).

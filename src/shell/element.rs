@@ -352,7 +352,7 @@ fn cholesky_above_minus_floor(m: &SMatrix<f64, NDOF, NDOF>, live: &[usize]) -> b
 }
 
 /// Generic reference twin of E_Δ: A k ψ(S z(q)) from the reference strain chain and the reference material.
-pub fn energy_reference<D: crate::diff::Real>(
+pub fn energy_reference<D: crate::real::Real>(
     model: &ElementModel,
     q: &[D],
     rest: &RestTriangle,

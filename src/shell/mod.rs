@@ -13,14 +13,12 @@ pub mod strain;
 
 pub use strain::{strain, strain_reference, RestTriangle, StrainChain};
 pub mod assemble;
-pub mod checks;
 pub mod element;
 pub mod mesh;
 pub mod render;
 pub mod scene;
 pub mod solver;
 
-pub use checks::diff_checks;
 pub use element::{ElementModel, ModelFlags, Psd};
 pub use mesh::{Mesh, Stencil};
 

@@ -2,6 +2,7 @@
 //! open"): orthographic view from an azimuth and elevation, z-buffer, two-sided Lambert shading, 2× supersampling,
 //! written as PNG. Obstacles are drawn as meshes ([`sphere_mesh`]) in their own colour.
 
+use crate::real::{cross, dot};
 use std::path::Path;
 
 /// Camera and image size of a snapshot.
@@ -70,20 +71,8 @@ fn basis(view: &View) -> [[f64; 3]; 3] {
     // direction from the scene towards the camera
     let back = [-a.sin() * e.cos(), -a.cos() * e.cos(), e.sin()];
     let right = [a.cos(), -a.sin(), 0.0];
-    let up = cross(back, right);
+    let up = cross(&back, &right);
     [right, up, back]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// Render the layers into an RGB image (row-major, `width × height × 3`); the view is fitted to the bounding
@@ -92,7 +81,7 @@ pub fn render(layers: &[Layer], view: &View) -> Vec<u8> {
     const SS: usize = 2;
     let (w, h) = (view.width as usize * SS, view.height as usize * SS);
     let [right, up, back] = basis(view);
-    let project = |p: [f64; 3]| [dot(p, right), dot(p, up), dot(p, back)];
+    let project = |p: [f64; 3]| [dot(&p, &right), dot(&p, &up), dot(&p, &back)];
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for l in layers {
         for &p in l.positions {
@@ -117,7 +106,7 @@ pub fn render(layers: &[Layer], view: &View) -> Vec<u8> {
                 0.4 * right[1] + 0.6 * up[1] + back[1],
                 0.4 * right[2] + 0.6 * up[2] + back[2],
             ];
-            let n = dot(l, l).sqrt();
+            let n = dot(&l, &l).sqrt();
             l.map(|v| v / n)
         };
         for l in layers {
@@ -136,14 +125,14 @@ pub fn render(layers: &[Layer], view: &View) -> Vec<u8> {
             for t in l.triangles {
                 let [a, b, d] = t.map(|i| l.positions[i]);
                 let n = cross(
-                    [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
-                    [d[0] - a[0], d[1] - a[1], d[2] - a[2]],
+                    &[b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                    &[d[0] - a[0], d[1] - a[1], d[2] - a[2]],
                 );
-                let nn = dot(n, n).sqrt();
+                let nn = dot(&n, &n).sqrt();
                 if nn == 0.0 {
                     continue;
                 }
-                let shade = 0.3 + 0.7 * (dot(n, light) / nn).abs();
+                let shade = 0.3 + 0.7 * (dot(&n, &light) / nn).abs();
                 let color = l.color.map(|v| (v as f64 * shade).round().min(255.0) as u8);
                 fill_triangle(t.map(|i| px[i]), color, w, h, &mut rgb, &mut depth);
             }

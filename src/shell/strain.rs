@@ -20,7 +20,7 @@
 //! these expressions (each wing depends on (e, w) only), and κ_i = θ_i h_i by the product rule.
 //! Only the contraction Σ_k w_k ∇²z_k is formed; the full 6×18×18 tensor is the contraction with unit vectors.
 
-use crate::diff::Real;
+use crate::real::Real;
 use nalgebra::{Matrix3, Vector3};
 
 type V3 = Vector3<f64>;

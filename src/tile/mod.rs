@@ -8,17 +8,16 @@
 //! value, gradient and Hessian are those of one smooth function of the dofs (what the derivative harness checks).
 
 pub mod calibration;
-pub(crate) mod checks;
 pub mod contact;
 
-pub use checks::diff_checks;
 pub use contact::ContactPair;
 
 use crate::contact::ContactError;
 use crate::pattern::Pattern;
+use crate::periodic::{Placement, TileTransforms};
 use crate::rod::bend_twist::{bend_twist_parts, bend_twist_parts_vgh, BendTwistParams};
 use crate::rod::stretch::{stretch_value, stretch_vgh};
-use crate::rod::{Placement, RodState, RodTopology, TileTransforms, YarnMaterial};
+use crate::rod::{RodState, RodTopology, YarnMaterial};
 use nalgebra::{DVector, Matrix3, Vector3};
 use rayon::prelude::*;
 

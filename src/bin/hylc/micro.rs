@@ -1,11 +1,11 @@
 //! `hylc solve`, `hylc reference`, `hylc sensitivity`: the micro solver on one pattern
 //! (`03-homogenization.md`; `hylc::micro`).
 
+use hylc::generate::default_pattern;
 use hylc::micro::envelope::{parameter_derivatives, strain_derivatives, PARAMETER_NAMES};
 use hylc::micro::solver::world_positions;
 use hylc::micro::strain::STRAIN_NAMES;
 use hylc::micro::{MacroStrain, MicroProblem, Solution, SolverOptions};
-use hylc::pattern::generate::default_pattern;
 use hylc::pattern::Pattern;
 use hylc::rod::YarnMaterial;
 use serde_json::json;

@@ -12,13 +12,14 @@
 //! stretching K = k_s l̄ (the energy of unit strain), gradient k_s, Hessian k_s / min(l, l̄). Position inputs are
 //! scaled by L, angles by 1.
 
-use super::bend_twist::{
+use crate::diff::{Check, Differentiable, Scales, Vgh};
+use crate::real::Real;
+use crate::rod::bend_twist::{
     bend_twist_reference, bend_twist_value, bend_twist_vgh, unpack, BendTwistParams, StencilFrames,
 };
-use super::frame::reference_twist_raw;
-use super::stretch::{stretch_reference, stretch_value, stretch_vgh};
-use super::YarnMaterial;
-use crate::diff::{Check, Differentiable, Real, Scales, Vgh};
+use crate::rod::frame::reference_twist_raw;
+use crate::rod::stretch::{stretch_reference, stretch_value, stretch_vgh};
+use crate::rod::YarnMaterial;
 use nalgebra::{DMatrix, DVector, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;

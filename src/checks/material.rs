@@ -6,9 +6,10 @@
 //! coefficients, not to its value (a residual 2D term is ~1e-8 near its axes while its data are ~1e-2). Gradient
 //! and Hessian scales are V/σ and V/σ² with σ the smallest strain scale among the inputs the function uses.
 
-use super::synthetic::default_material;
-use super::{Hermite1D, Hermite2D, Material};
-use crate::diff::{Check, Differentiable, Real, Scales, Vgh};
+use crate::diff::{Check, Differentiable, Scales, Vgh};
+use crate::material::synthetic::default_material;
+use crate::material::{Hermite1D, Hermite2D, Material};
+use crate::real::Real;
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;

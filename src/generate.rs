@@ -17,7 +17,7 @@
 //! Vertex order: yarn by yarn, each yarn's vertices contiguous in the order its edges visit them; `edge_file_order`
 //! is `0..n`.
 
-use super::{Edge, Pattern};
+use crate::pattern::{Edge, Pattern};
 use crate::rod::frame::transport;
 use crate::rod::state::{raw_reference_twists, set_rest_to_current};
 use nalgebra::Vector3;

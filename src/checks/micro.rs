@@ -9,14 +9,15 @@
 //! strain (ũ = 0), and perturbations of 0.05 r / 0.1 rad and 0.2 r / 0.3 rad (θ also shifted by ±2π). Scales
 //! as for the whole-tile row ([`crate::tile`]).
 
-use super::elimination::{stencil_copies, Elimination};
-use super::solver::{MicroProblem, MicroState, SolverOptions};
-use super::strain::MacroStrain;
+use crate::checks::tile::reference_energy;
 use crate::contact::GaussLegendre;
-use crate::diff::{Check, Differentiable, Real, Scales, Vgh};
+use crate::diff::{Check, Differentiable, Scales, Vgh};
+use crate::micro::elimination::{stencil_copies, Elimination};
+use crate::micro::solver::{MicroProblem, MicroState, SolverOptions};
+use crate::micro::strain::MacroStrain;
 use crate::pattern::Pattern;
+use crate::real::Real;
 use crate::rod::YarnMaterial;
-use crate::tile::checks::reference_energy;
 use crate::tile::{ContactPair, Terms, Tile, Want};
 use nalgebra::{DMatrix, DVector};
 use rand::Rng;
@@ -248,7 +249,7 @@ pub fn diff_checks() -> Vec<Box<dyn Check>> {
         MacroStrain::new(0.05, 0.1, 0.0, 60.0, 0.0),
         MacroStrain::new(-0.05, -0.1, 0.02, 0.0, -50.0),
     ];
-    crate::pattern::generate::harness_patterns()
+    crate::generate::harness_patterns()
         .into_iter()
         .map(|(name, p)| {
             Box::new(ReducedEnergyCheck {

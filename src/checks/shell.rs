@@ -16,13 +16,14 @@
 //! ρ² h_max/h_min². The row of w·z uses Σ|w_k| times these; the energy rows use A·k·V (V the material's data
 //! magnitude, as the ψ rows) times the chain magnitudes divided by the strain scales σ.
 
-use super::assemble::{gather, Pattern};
-use super::element::{energy_reference, ElementModel, ModelFlags, Psd};
-use super::mesh::{Mesh, Stencil};
-use super::strain::{strain_reference, RestTriangle, StrainChain, NDOF};
-use crate::diff::{Check, Differentiable, Real, Scales, Vgh};
+use crate::diff::{Check, Differentiable, Scales, Vgh};
 use crate::material::synthetic::default_material;
 use crate::material::Material;
+use crate::real::Real;
+use crate::shell::assemble::{gather, Pattern};
+use crate::shell::element::{energy_reference, ElementModel, ModelFlags, Psd};
+use crate::shell::mesh::{Mesh, Stencil};
+use crate::shell::strain::{strain_reference, RestTriangle, StrainChain, NDOF};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -465,8 +466,14 @@ impl Differentiable for MeshCheck {
     }
     fn fast(&self, x: &[f64]) -> Vgh {
         let n = self.dim();
-        match super::assemble::assemble(&self.model, &self.stencils, &self.pattern, x, true, false)
-        {
+        match crate::shell::assemble::assemble(
+            &self.model,
+            &self.stencils,
+            &self.pattern,
+            x,
+            true,
+            false,
+        ) {
             Some(a) => {
                 let mut h = DMatrix::zeros(n, n);
                 for c in 0..n {
@@ -490,7 +497,7 @@ impl Differentiable for MeshCheck {
         }
     }
     fn fast_value(&self, x: &[f64]) -> f64 {
-        super::assemble::energy(&self.model, &self.stencils, x).unwrap_or(f64::NAN)
+        crate::shell::assemble::energy(&self.model, &self.stencils, x).unwrap_or(f64::NAN)
     }
     fn sample(&self, rng: &mut ChaCha8Rng, i: usize) -> Vec<f64> {
         // a smooth random deformation: in-plane stretch/shear, bending into a cylinder-like sheet, noise

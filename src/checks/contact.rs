@@ -10,10 +10,11 @@
 //!
 //! Kinks: f is only C¹ at ρ = 1, so [`Differentiable::kink_distance`] is min over node pairs of |‖d_pq‖ − 2r|:
 //! a change h of one coordinate moves every ‖d_pq‖ by at most |c_k| h ≤ h, so no quadrature distance crosses 2r
-//! within that step. The one-sided behaviour at the kink is a unit test in [`super::pair`].
+//! within that step. The one-sided behaviour at the kink is a unit test in [`crate::contact::pair`].
 
-use super::{pair_energy_reference, PairKernel};
-use crate::diff::{Check, Differentiable, Real, Scales, Vgh};
+use crate::contact::{pair_energy_reference, PairKernel};
+use crate::diff::{Check, Differentiable, Scales, Vgh};
+use crate::real::Real;
 use nalgebra::{DMatrix, DVector, Matrix3, UnitQuaternion, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -177,7 +178,7 @@ pub fn sample_pair(rng: &mut ChaCha8Rng, i: usize, r: f64, order: usize) -> [Vec
             usual_len(rng),
         ),
     };
-    let rule = super::GaussLegendre::new(order);
+    let rule = crate::contact::GaussLegendre::new(order);
     let nodes = rule.nodes();
     let (p, q, jitter) = if cat == 6 {
         // end nodes, segments pointing away from the crossing

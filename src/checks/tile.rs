@@ -8,14 +8,15 @@
 //! stencils). Inputs are scaled by r (positions) and 1 (angles). Contact is C¹ at ρ = 1: finite differences stay
 //! below the smallest distance from a quadrature pair to the cut-off.
 
-use super::{Terms, Tile, Want};
 use crate::contact::pair_energy_reference;
 use crate::contact::GaussLegendre;
-use crate::diff::{Check, Differentiable, Real, Scales, Vgh};
+use crate::diff::{Check, Differentiable, Scales, Vgh};
 use crate::pattern::Pattern;
+use crate::real::Real;
 use crate::rod::bend_twist::bend_twist_reference;
 use crate::rod::stretch::stretch_reference;
 use crate::rod::{RodState, YarnMaterial};
+use crate::tile::{Terms, Tile, Want};
 use nalgebra::DMatrix;
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -26,7 +27,7 @@ pub struct TileCheck {
     pattern: Pattern,
     material: YarnMaterial,
     frames: RodState,
-    contacts: Vec<super::ContactPair>,
+    contacts: Vec<crate::tile::ContactPair>,
     rule: GaussLegendre,
 }
 
@@ -212,7 +213,7 @@ pub(crate) fn reference_energy<D: Real>(
 /// The whole-tile rows: built from the embedded generated patterns (no external data needed).
 pub fn diff_checks() -> Vec<Box<dyn Check>> {
     let m = YarnMaterial::default();
-    crate::pattern::generate::harness_patterns()
+    crate::generate::harness_patterns()
         .into_iter()
         .map(|(name, p)| {
             Box::new(TileCheck::new(&format!("tile[{name}]"), p, &m)) as Box<dyn Check>
