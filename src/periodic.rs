@@ -196,9 +196,9 @@ impl TileImages {
             if images[..i].iter().any(|b| b.offset == a.offset) {
                 return bad(format!("duplicate tile image offset {:?}", a.offset));
             }
-            let neg = [-a.offset[0], -a.offset[1]];
-            if !images.iter().any(|b| b.offset == neg) {
-                return Err(PeriodicError::MissingImage { offset: neg });
+            let opposite = neg(a.offset);
+            if !images.iter().any(|b| b.offset == opposite) {
+                return Err(PeriodicError::MissingImage { offset: opposite });
             }
             let orth = (a.rotation.transpose() * a.rotation - Matrix3::identity()).norm();
             let rigid = orth <= 1e-9
