@@ -9,8 +9,9 @@
 //! 3. yarn mechanics: [`rod`], [`contact`], [`tile`], [`micro`];
 //! 4. homogenization: [`sample`], [`fit`];
 //! 5. cloth: [`shell`];
-//! 6. on top: [`generate`] (pattern generators), [`validate`] (conformance against the original data),
-//!    [`checks`] (every energy registered with the harness).
+//! 6. on top: [`generate`] (pattern generators), [`workflow`] (the stages put together as the command line runs
+//!    them, up to the main job), [`validate`] (conformance against the original data), [`checks`] (every energy
+//!    registered with the harness).
 
 // 1. foundations
 pub mod diff;
@@ -33,6 +34,7 @@ pub mod shell;
 pub mod checks;
 pub mod generate;
 pub mod validate;
+pub mod workflow;
 
 use std::path::PathBuf;
 

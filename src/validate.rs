@@ -31,7 +31,8 @@ fn nums(v: &Value) -> Result<Vec<f64>, String> {
     }
 }
 
-fn read_json(path: &Path) -> Result<Value, String> {
+/// A JSON file, with the file named in the error.
+pub fn read_json(path: &Path) -> Result<Value, String> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
     serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))

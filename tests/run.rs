@@ -7,6 +7,8 @@ mod common;
 
 use hylc::material::Material;
 use hylc::sample::Plan;
+use hylc::workflow::pipeline::{self, RunConfig};
+use hylc::workflow::Event;
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -101,6 +103,37 @@ fn run_writes_every_stage_and_resumes() {
     let ps = &s["patterns"]["plain"];
     assert_eq!(ps["samples"]["already_done"], n);
     assert_eq!(ps["samples"]["written"], 0);
+
+    // the same job through the library: every log line reaches the callback and run.log, the drape reports each
+    // step once, in order, and the summary is the one written to summary.json
+    let log_before = std::fs::read_to_string(out.join("run.log")).unwrap();
+    let config = RunConfig {
+        out: out.clone(),
+        patterns: vec!["plain".into()],
+        plan: plan.to_str().unwrap().into(),
+        edge: Some(0.03),
+        duration: Some(0.05),
+        dt: 0.0125,
+        ..RunConfig::default()
+    };
+    let (mut lines, mut steps) = (Vec::new(), Vec::new());
+    let summary = pipeline::run(&config, &mut |e| match e {
+        Event::Log(l) => lines.push(l.to_string()),
+        Event::Step { done, total, .. } => steps.push((done, total)),
+        Event::Print(_) | Event::Note(_) => {}
+    })
+    .unwrap();
+    let log_after = std::fs::read_to_string(out.join("run.log")).unwrap();
+    assert_eq!(
+        log_after.strip_prefix(log_before.as_str()).unwrap(),
+        lines.iter().map(|l| format!("{l}\n")).collect::<String>()
+    );
+    assert!(lines.iter().any(|l| l.starts_with("reference: reused")));
+    assert_eq!(steps, vec![(1, 4), (2, 4), (3, 4), (4, 4)]);
+    let written: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary, written);
+    assert_eq!(summary["patterns"]["plain"]["samples"]["written"], 0);
 
     // scene-driven sampling from the drape's strain log: a valid plan, smaller than the default one
     let sp = dir.join("scene_plan.json");

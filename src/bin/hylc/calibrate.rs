@@ -1,13 +1,36 @@
 //! `hylc calibrate`: the yarn-parameter calibration against the original reference patterns
 //! (`06-verification.md` item b; `hylc::tile::calibration`).
 
+use crate::args::parse_list;
+use anyhow::anyhow;
 use hylc::pattern::Pattern;
 use hylc::rod::YarnMaterial;
 use hylc::tile::calibration::{
     calibrate, equilibrium_periods, Calibration, ContactForm, Stiffness,
 };
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
+
+/// Calibrate the yarn parameters so that the original reference patterns are static equilibria: per contact
+/// form, the residual force at the defaults, the best parameters per pattern and the joint fit.
+#[derive(clap::Args)]
+pub struct Args {
+    /// folder with the original `.pyp` files (default: ../shared/data/hylc2020/patterns)
+    #[arg(long)]
+    pub dir: Option<PathBuf>,
+    /// contact quadrature orders to try (comma-separated)
+    #[arg(long, default_value = "4")]
+    pub quadrature: String,
+    /// contact exclusions (neighbour segments on each side) to try
+    #[arg(long, default_value = "3")]
+    pub exclusion: String,
+    /// contact radius factors to try (contact distance 2 x factor x r)
+    #[arg(long, default_value = "1")]
+    pub radius_factor: String,
+    /// write all rows as JSON
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
 
 /// The original patterns, the set the joint fit uses, and the file names.
 const ORIGINALS: [&str; 5] = [
@@ -19,37 +42,23 @@ const ORIGINALS: [&str; 5] = [
 ];
 const FIT_SET: [&str; 3] = ["basket", "satin", "slip_stitch_honeycomb"];
 
-fn parse_list<T: std::str::FromStr>(text: &str, what: &str) -> Result<Vec<T>, String> {
-    text.split(',')
-        .map(|s| {
-            s.trim()
-                .parse()
-                .map_err(|_| format!("--{what}: cannot parse {s:?} in {text:?}"))
-        })
-        .collect()
-}
-
-pub fn run(
-    dir: Option<&Path>,
-    quadrature: &str,
-    exclusion: &str,
-    radius_factor: &str,
-    json: Option<&Path>,
-) -> Result<ExitCode, String> {
-    let dir: PathBuf = match dir {
-        Some(d) => d.to_path_buf(),
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let dir: PathBuf = match a.dir {
+        Some(d) => d,
         None => hylc::shared_dir()
             .map(|s| s.join("data/hylc2020/patterns"))
-            .ok_or("the original patterns were not found: pass --dir or set HYLC_SHARED")?,
+            .ok_or_else(|| {
+                anyhow!("the original patterns were not found: pass --dir or set HYLC_SHARED")
+            })?,
     };
-    let qs: Vec<usize> = parse_list(quadrature, "quadrature")?;
-    let xs: Vec<usize> = parse_list(exclusion, "exclusion")?;
-    let rs: Vec<f64> = parse_list(radius_factor, "radius-factor")?;
+    let qs: Vec<usize> = parse_list(&a.quadrature, "quadrature")?;
+    let xs: Vec<usize> = parse_list(&a.exclusion, "exclusion")?;
+    let rs: Vec<f64> = parse_list(&a.radius_factor, "radius-factor")?;
     let material = YarnMaterial::default();
     let mut patterns: Vec<(String, Pattern)> = Vec::new();
     for name in ORIGINALS {
         let path = dir.join(format!("{name}.pyp"));
-        let (mut p, warnings) = Pattern::load_pyp(&path).map_err(|e| e.to_string())?;
+        let (mut p, warnings) = Pattern::load_pyp(&path)?;
         if !warnings.is_empty() {
             if let Some(implied) = p.implied_periods() {
                 // the rest lengths imply the periods to ~1e-4; the equilibrium (zero macro stress) fixes them
@@ -60,7 +69,7 @@ pub fn run(
                     &ContactForm::default(),
                     &Stiffness::from_material(&material),
                 )
-                .map_err(|e| format!("{name}: {e}"))?;
+                .map_err(|e| anyhow!("{name}: {e}"))?;
                 println!(
                     "{name}: stored periods {:.7} x {:.7} m are inconsistent with the periodic edges; \
                      the rest lengths imply {:.7} x {:.7} m; the equilibrium periods at the defaults are \
@@ -98,7 +107,7 @@ pub fn run(
                     radius_factor: rf,
                 };
                 let c = calibrate(&patterns, &FIT_SET, &form, &material)
-                    .map_err(|e| format!("calibration Q={q} exclusion={x}: {e}"))?;
+                    .map_err(|e| anyhow!("calibration Q={q} exclusion={x}: {e}"))?;
                 println!(
                     "\nQ = {q}, exclusion = {x}, contact radius x{rf}: joint fit gamma = {:.4}, G/Y = {:.4}, k_c = {:.1} J/m^2",
                     c.gamma, c.shear_over_young, c.contact_stiffness
@@ -135,10 +144,10 @@ pub fn run(
             }
         }
     }
-    if let Some(path) = json {
-        let text = serde_json::to_string_pretty(&all).map_err(|e| e.to_string())?;
+    if let Some(path) = &a.json {
+        let text = serde_json::to_string_pretty(&all)?;
         std::fs::write(path, text + "\n")
-            .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+            .map_err(|e| anyhow!("{}: cannot write: {e}", path.display()))?;
         println!("\nwrote {}", path.display());
     }
     Ok(ExitCode::SUCCESS)

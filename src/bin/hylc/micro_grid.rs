@@ -1,16 +1,66 @@
 //! `hylc micro-grid`: our micro solver against the original solver's displacements on the 9×9×9 in-plane grid
 //! (`../shared/design/06-verification.md`, item 3c; `hylc::micro::grid`).
 
-use crate::micro::load_pattern;
+use crate::args::{exit, SolverArgs};
+use crate::strain::load_pattern_noted;
+use anyhow::anyhow;
 use hylc::micro::grid::{run_grid, summarize, GridData, GridOptions, GridSummary, GRID_LEN};
 use hylc::micro::{MicroProblem, SolverOptions};
 use hylc::rod::YarnMaterial;
 use indicatif::{ProgressBar, ProgressStyle};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Our micro solver against the original solver's displacements on the 9×9×9 in-plane strain grid (validation
+/// item 3c): warm-started continuation over the grid, position and θ errors relative to each side's z = 0 state,
+/// convergence with every failure, Newton steps warm vs cold.
+#[derive(clap::Args)]
+pub struct Args {
+    /// `.pyp` file of the original pattern
+    pattern: String,
+    /// folder with `axes.txt` and `data.npy` (e.g. ../shared/data/hylc2020/displacements/satin)
+    data_dir: PathBuf,
+    /// write the summary as JSON
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// solve only the first N points of the continuation order (a quick partial run)
+    #[arg(long)]
+    limit: Option<usize>,
+    /// also solve every N-th grid point cold for the warm-vs-cold statistics (0: none)
+    #[arg(long, default_value_t = 16)]
+    cold_every: usize,
+    #[command(flatten)]
+    solver: SolverArgs,
+    /// no per-yarn slide constraints
+    #[arg(long)]
+    no_slide_constraints: bool,
+    /// keep the `.pyp` file's periods even where they disagree with the rest lengths (by default the
+    /// implied periods are used, as in `hylc solve`)
+    #[arg(long)]
+    file_periods: bool,
+}
+
+/// `hylc micro-grid`: exit code 3 when a continuation point did not converge.
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let options = SolverOptions {
+        slide_constraints: !a.no_slide_constraints,
+        ..a.solver.options()
+    };
+    let ok = grid(
+        &a.pattern,
+        &a.data_dir,
+        a.json.as_deref(),
+        a.limit,
+        a.cold_every,
+        a.file_periods,
+        options,
+    )?;
+    Ok(exit(ok, 3))
+}
 
 /// Run the grid of one pattern, print the summary, optionally write it as JSON. `Ok(true)` when every
 /// continuation point converged.
-pub fn run(
+pub fn grid(
     pattern: &str,
     data_dir: &Path,
     json: Option<&Path>,
@@ -18,18 +68,16 @@ pub fn run(
     cold_every: usize,
     file_periods: bool,
     options: SolverOptions,
-) -> Result<bool, String> {
+) -> anyhow::Result<bool> {
     let p = if file_periods {
         // the periods as written, even where they disagree with the rest lengths (a diagnostic for basket)
-        hylc::pattern::Pattern::load_pyp(pattern)
-            .map_err(|e| e.to_string())?
-            .0
+        hylc::pattern::Pattern::load_pyp(pattern)?.0
     } else {
-        load_pattern(pattern)?
+        load_pattern_noted(pattern)?
     };
-    let data = GridData::load(data_dir).map_err(|e| e.to_string())?;
+    let data = GridData::load(data_dir)?;
     data.check_pattern(&p)
-        .map_err(|e| format!("{pattern} with {}: {e}", data_dir.display()))?;
+        .map_err(|e| anyhow!("{pattern} with {}: {e}", data_dir.display()))?;
     let problem = MicroProblem::new(p, &YarnMaterial::default(), options);
     let planned = limit.unwrap_or(GRID_LEN).min(GRID_LEN)
         + if cold_every == 0 {
@@ -39,14 +87,13 @@ pub fn run(
         };
     let bar = ProgressBar::new(planned as u64);
     bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} solves, eta {eta}")
-            .map_err(|e| e.to_string())?
+        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} solves, eta {eta}")?
             .progress_chars("=> "),
     );
     let opts = GridOptions { limit, cold_every };
     let result = run_grid(&problem, &data, &opts, &|| bar.inc(1));
     bar.finish_and_clear();
-    let run = result.map_err(|e| format!("{pattern}: {e}"))?;
+    let run = result.map_err(|e| anyhow!("{pattern}: {e}"))?;
     let summary = summarize(&problem, &data, &run);
     print_summary(pattern, &summary);
     if let Some(path) = json {
@@ -76,13 +123,13 @@ fn write_json(
     limit: Option<usize>,
     file_periods: bool,
     summary: &GridSummary,
-) -> Result<(), String> {
+) -> anyhow::Result<()> {
     let mut root = if path.exists() {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = std::fs::read_to_string(path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
         let v: serde_json::Value = serde_json::from_str(&text)
-            .map_err(|e| format!("{}: not JSON ({e}); not overwriting it", path.display()))?;
+            .map_err(|e| anyhow!("{}: not JSON ({e}); not overwriting it", path.display()))?;
         if !v.get("runs").is_some_and(|r| r.is_object()) {
-            return Err(format!(
+            return Err(anyhow!(
                 "{}: not a micro-grid results file (no \"runs\" object); not overwriting it",
                 path.display()
             ));
@@ -115,8 +162,8 @@ fn write_json(
         "options": options,
         "summary": summary,
     });
-    let text = serde_json::to_string_pretty(&root).map_err(|e| e.to_string())?;
-    std::fs::write(path, text + "\n").map_err(|e| format!("{}: {e}", path.display()))
+    let text = serde_json::to_string_pretty(&root)?;
+    std::fs::write(path, text + "\n").map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
 fn print_summary(pattern: &str, s: &GridSummary) {

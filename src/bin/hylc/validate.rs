@@ -3,9 +3,11 @@
 //! README between the markers `<!-- validate:begin -->` and `<!-- validate:end -->`). Skips cleanly, with a
 //! message and exit code 0, when `../shared` is absent.
 
-use hylc::validate::{psi_conformance, strain_conformance};
-use serde_json::Value;
+use crate::args::exit;
+use anyhow::anyhow;
+use hylc::validate::{psi_conformance, read_json, strain_conformance};
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 use std::time::Instant;
 
 /// The original patterns: (`.pyp` stem, displacement folder, fitted material).
@@ -27,18 +29,41 @@ struct Row {
     command: String,
 }
 
-/// Settings of `hylc validate`.
-pub struct ValidateArgs {
-    pub write: PathBuf,
-    pub readme: Option<PathBuf>,
-    /// micro-grid points per pattern (None: all 729)
-    pub grid_limit: Option<usize>,
+/// The validation items of 06-verification.md (section 3) against ../shared: conformance with the original
+/// code, the original patterns as equilibria, the micro solver against the original displacements, the fitted
+/// materials against the original ones; writes the results table (skips when ../shared is absent).
+#[derive(clap::Args)]
+pub struct Args {
+    /// the results table (Markdown)
+    #[arg(long, default_value = "validation/results.md")]
+    write: PathBuf,
+    /// also put the table into this README between `<!-- validate:begin -->` and `<!-- validate:end -->`
+    #[arg(long)]
+    readme: Option<PathBuf>,
+    /// micro-grid points per pattern (the first N of the continuation order)
+    #[arg(long, default_value_t = 61)]
+    grid_limit: usize,
+    /// all 729 micro-grid points per pattern (about 40 min on 2 cores)
+    #[arg(long)]
+    full: bool,
 }
 
-fn read_json(path: &Path) -> Result<Value, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
-    serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+/// Settings of the validation run.
+struct ValidateArgs {
+    write: PathBuf,
+    readme: Option<PathBuf>,
+    /// micro-grid points per pattern (None: all 729)
+    grid_limit: Option<usize>,
+}
+
+/// `hylc validate`: exit code 1 when an item with a target misses it.
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let ok = validate(&ValidateArgs {
+        write: a.write,
+        readme: a.readme,
+        grid_limit: (!a.full).then_some(a.grid_limit),
+    })?;
+    Ok(exit(ok, 1))
 }
 
 fn verdict(p: Option<bool>) -> &'static str {
@@ -49,8 +74,8 @@ fn verdict(p: Option<bool>) -> &'static str {
     }
 }
 
-/// `hylc validate`; Ok(false) when an item with a target misses it.
-pub fn run(args: &ValidateArgs) -> Result<bool, String> {
+/// The validation run; Ok(false) when an item with a target misses it.
+fn validate(args: &ValidateArgs) -> anyhow::Result<bool> {
     let Some(shared) = hylc::shared_dir() else {
         println!(
             "validate: skipped: ../shared (the original data and oracles) not found; set HYLC_SHARED to run it"
@@ -61,7 +86,7 @@ pub fn run(args: &ValidateArgs) -> Result<bool, String> {
     let mut rows = Vec::new();
 
     // 3a: conformance with the original macro-scale code
-    let psi = psi_conformance(&shared, 1e-10, 1e-8)?;
+    let psi = psi_conformance(&shared, 1e-10, 1e-8).map_err(anyhow::Error::msg)?;
     for c in &psi {
         rows.push(Row {
             item: "a",
@@ -72,7 +97,7 @@ pub fn run(args: &ValidateArgs) -> Result<bool, String> {
             command: "cargo test --release --test conformance_psi -- --nocapture".into(),
         });
     }
-    let sc = strain_conformance(&shared, 1e-10)?;
+    let sc = strain_conformance(&shared, 1e-10).map_err(anyhow::Error::msg)?;
     rows.push(Row {
         item: "a",
         what: format!(
@@ -91,10 +116,16 @@ pub fn run(args: &ValidateArgs) -> Result<bool, String> {
 
     // 3b: the reference patterns as equilibria at the calibrated defaults
     let tmp = std::env::temp_dir().join(format!("hylc_validate_{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).map_err(|e| format!("{}: {e}", tmp.display()))?;
+    std::fs::create_dir_all(&tmp).map_err(|e| anyhow!("{}: cannot create: {e}", tmp.display()))?;
     let cal_json = tmp.join("calibration.json");
-    crate::calibrate::run(None, "4", "3", "1", Some(&cal_json))?;
-    let cal = read_json(&cal_json)?;
+    crate::calibrate::run(crate::calibrate::Args {
+        dir: None,
+        quadrature: "4".into(),
+        exclusion: "3".into(),
+        radius_factor: "1".into(),
+        json: Some(cal_json.clone()),
+    })?;
+    let cal = read_json(&cal_json).map_err(anyhow::Error::msg)?;
     let form = &cal[0];
     let y = hylc::rod::YarnMaterial::default();
     for r in form["rows"].as_array().into_iter().flatten() {
@@ -133,7 +164,7 @@ pub fn run(args: &ValidateArgs) -> Result<bool, String> {
             max_steps: 2000,
             ..Default::default()
         };
-        crate::micro_grid::run(
+        crate::micro_grid::grid(
             &pattern.display().to_string(),
             &data,
             Some(&json),
@@ -142,12 +173,12 @@ pub fn run(args: &ValidateArgs) -> Result<bool, String> {
             false,
             options,
         )?;
-        let v = read_json(&json)?;
+        let v = read_json(&json).map_err(anyhow::Error::msg)?;
         let s = v["runs"]
             .as_object()
             .and_then(|m| m.values().next())
             .map(|r| r["summary"].clone())
-            .ok_or_else(|| format!("{}: no run", json.display()))?;
+            .ok_or_else(|| anyhow!("{}: no run", json.display()))?;
         let pe = &s["position_error_yarn_translation_removed"];
         rows.push(Row {
             item: "c",
@@ -244,7 +275,7 @@ pub fn run(args: &ValidateArgs) -> Result<bool, String> {
 
     let table = format_table(&rows, args.grid_limit, t0.elapsed().as_secs_f64());
     std::fs::write(&args.write, &table)
-        .map_err(|e| format!("{}: cannot write: {e}", args.write.display()))?;
+        .map_err(|e| anyhow!("{}: cannot write: {e}", args.write.display()))?;
     print!("\n{table}");
     println!("wrote {}", args.write.display());
     if let Some(readme) = &args.readme {
@@ -281,21 +312,21 @@ const BEGIN: &str = "<!-- validate:begin -->";
 const END: &str = "<!-- validate:end -->";
 
 /// Replace the text between the markers in the README with the table.
-fn splice_readme(readme: &Path, table: &str) -> Result<(), String> {
+fn splice_readme(readme: &Path, table: &str) -> anyhow::Result<()> {
     let text = std::fs::read_to_string(readme)
-        .map_err(|e| format!("{}: cannot read: {e}", readme.display()))?;
+        .map_err(|e| anyhow!("{}: cannot read: {e}", readme.display()))?;
     let (Some(a), Some(b)) = (text.find(BEGIN), text.find(END)) else {
-        return Err(format!(
+        return Err(anyhow!(
             "{}: no `{BEGIN}` … `{END}` markers to put the table between",
             readme.display()
         ));
     };
     if b < a {
-        return Err(format!(
+        return Err(anyhow!(
             "{}: `{END}` comes before `{BEGIN}`",
             readme.display()
         ));
     }
     let new = format!("{}{BEGIN}\n{table}{}", &text[..a], &text[b..]);
-    std::fs::write(readme, new).map_err(|e| format!("{}: cannot write: {e}", readme.display()))
+    std::fs::write(readme, new).map_err(|e| anyhow!("{}: cannot write: {e}", readme.display()))
 }

@@ -1,45 +1,74 @@
-//! `hylc run`: the main job end to end (`../shared/design/01-architecture.md`, "Command line"; the pipeline of
+//! The main job end to end (`../shared/design/01-architecture.md`, "Command line"; the pipeline of
 //! `../shared/seed/hylc_pseudocode.txt`, C1 → C4 → C5–C7 → C8). For each pattern: generate it, compute its
-//! reference state (C1), run the quick sampling plan and a small held-out in-plane grid (C4), fit the material
-//! (C5–C7), and drape a cloth with it (C8); print a per-stage summary and write everything to one folder.
+//! reference state (C1), run a sampling plan and a small held-out in-plane grid (C4), fit the material
+//! (C5–C7), and drape a cloth with it (C8); report a per-stage summary and write everything to one folder.
 //!
 //! Long work resumes: a rerun with the same folder reuses the reference state and skips finished samples
-//! (`--fresh` starts over).
+//! (`fresh` starts over).
 
-use crate::fit::{fit, FitArgs};
-use crate::micro::{construction_of, load_pattern};
-use crate::sample::{load_plan, write_meta};
-use crate::simulate::{execute, prepare, snapshot, summary_line, Overrides};
-use hylc::fit::model::{FitOptions, FitReport};
-use hylc::micro::reference::{reference_state, ReferenceOptions};
-use hylc::micro::{MicroProblem, SolverOptions};
-use hylc::pattern::Pattern;
-use hylc::rod::YarnMaterial;
-use hylc::sample::plan::{fnv1a64, InPlaneGrid};
-use hylc::sample::{run_plan, Plan, RunOptions};
+use super::fit::{fit_samples, FitJob};
+use super::inputs::{construction_of, load_pattern, load_plan};
+use super::sidecar::write_meta;
+use super::simulate::{execute, prepare, snapshot, summary_line, Overrides};
+use super::{write_file, Event, WorkflowError};
+use crate::fit::model::FitReport;
+use crate::micro::reference::{reference_state, Construction, ReferenceOptions};
+use crate::micro::{MicroProblem, SolverOptions};
+use crate::pattern::Pattern;
+use crate::rod::YarnMaterial;
+use crate::sample::plan::{fnv1a64, InPlaneGrid};
+use crate::sample::{run_plan, Plan, RunOptions};
 use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Settings of `hylc run`.
-pub struct RunArgs {
+/// Settings of the main job (`hylc run`).
+#[derive(Clone, Debug)]
+pub struct RunConfig {
+    /// The output folder.
     pub out: PathBuf,
-    /// generated kinds or `.pyp` files
+    /// Generated kinds or `.pyp` files.
     pub patterns: Vec<String>,
-    /// `quick`, `reduced`, `default` or a plan file
+    /// `quick`, `reduced`, `default` or a plan file.
     pub plan: String,
+    /// A built-in scene or a scene file.
     pub scene: String,
+    /// Edge length (m) of the scene's rectangle mesh.
     pub edge: Option<f64>,
+    /// Simulated time (s) instead of the scene's.
     pub duration: Option<f64>,
-    /// time step of the cloth simulation (s)
+    /// Time step of the cloth simulation (s).
     pub dt: f64,
+    /// Delete the output folder first instead of resuming.
     pub fresh: bool,
-    pub construction: Option<String>,
+    /// The construction of `.pyp` patterns (generated kinds know theirs).
+    pub construction: Option<Construction>,
+    /// Show the sampler's own progress bar on stderr.
+    pub sample_progress: bool,
 }
 
-/// The held-out check of `run`: 27 in-plane points off the sampled planes (every other interior value of the
-/// original 9×9×9 grid: s_x, s_y ∈ {−0.1, 1/6, 1/2}, s_a ∈ {−0.35, 0, 0.35}).
+impl Default for RunConfig {
+    /// The defaults of `hylc run`: the generated stockinette, the quick plan, the `drape-x` scene at 1 cm edges
+    /// and 1/240 s, in `out/run`.
+    fn default() -> Self {
+        RunConfig {
+            out: PathBuf::from("out/run"),
+            patterns: vec!["stockinette".into()],
+            plan: "quick".into(),
+            scene: "drape-x".into(),
+            edge: Some(0.01),
+            duration: None,
+            dt: 1.0 / 240.0,
+            fresh: false,
+            construction: None,
+            sample_progress: false,
+        }
+    }
+}
+
+/// The held-out check of the main job: 27 in-plane points off the sampled planes (every other interior value of
+/// the original 9×9×9 grid: s_x, s_y ∈ {−0.1, 1/6, 1/2}, s_a ∈ {−0.35, 0, 0.35}).
 pub fn run_holdout_plan() -> Plan {
     let g = InPlaneGrid::original();
     let pick = |v: &[f64]| vec![v[1], v[3], v[5]];
@@ -53,13 +82,22 @@ pub fn run_holdout_plan() -> Plan {
     }
 }
 
-/// A log that prints each line and keeps it in `run.log`.
-struct Log(std::fs::File, PathBuf);
+/// A log that reports each line as an [`Event::Log`] and keeps it in `run.log`.
+struct Log<'a> {
+    file: std::fs::File,
+    path: PathBuf,
+    on_event: &'a mut dyn FnMut(Event),
+}
 
-impl Log {
-    fn line(&mut self, text: &str) -> Result<(), String> {
-        println!("{text}");
-        writeln!(self.0, "{text}").map_err(|e| format!("{}: {e}", self.1.display()))
+impl Log<'_> {
+    fn line(&mut self, text: &str) -> Result<(), WorkflowError> {
+        (self.on_event)(Event::Log(text));
+        writeln!(self.file, "{text}").map_err(|e| WorkflowError::io(&self.path, "cannot write", e))
+    }
+
+    /// An event that is not part of the log.
+    fn event(&mut self, e: Event) {
+        (self.on_event)(e)
     }
 }
 
@@ -70,22 +108,30 @@ struct PatternRun {
     summary: serde_json::Value,
 }
 
-/// `hylc run`: Ok(true) when every stage finished (steps that ended at the Newton cap are reported, not failed).
-pub fn run(args: &RunArgs) -> Result<bool, String> {
+/// The main job: every pattern of `args` through every stage, reported through `on_event`. Returns the summary
+/// that it also writes to `summary.json` (drape steps that ended at the Newton cap are reported, not failed).
+pub fn run(
+    args: &RunConfig,
+    on_event: &mut dyn FnMut(Event),
+) -> Result<serde_json::Value, WorkflowError> {
     let t0 = Instant::now();
     if args.fresh && args.out.exists() {
         std::fs::remove_dir_all(&args.out)
-            .map_err(|e| format!("{}: cannot remove: {e}", args.out.display()))?;
+            .map_err(|e| WorkflowError::io(&args.out, "cannot remove", e))?;
     }
     std::fs::create_dir_all(&args.out)
-        .map_err(|e| format!("{}: cannot create: {e}", args.out.display()))?;
+        .map_err(|e| WorkflowError::io(&args.out, "cannot create", e))?;
     let log_path = args.out.join("run.log");
     let file = std::fs::OpenOptions::new()
         .create(true)
         .append(true)
         .open(&log_path)
-        .map_err(|e| format!("{}: {e}", log_path.display()))?;
-    let mut log = Log(file, log_path.clone());
+        .map_err(|e| WorkflowError::io(&log_path, "cannot open", e))?;
+    let mut log = Log {
+        file,
+        path: log_path.clone(),
+        on_event,
+    };
     log.line(&format!(
         "hylc run: patterns {}, plan {}, scene {}; output in {}",
         args.patterns.join(", "),
@@ -148,11 +194,10 @@ pub fn run(args: &RunArgs) -> Result<bool, String> {
         "plan": args.plan, "scene": args.scene, "total_time": total,
     });
     let path = args.out.join("summary.json");
-    std::fs::write(
+    write_file(
         &path,
-        serde_json::to_string_pretty(&summary).expect("json") + "\n",
-    )
-    .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+        serde_json::to_string_pretty(&summary).expect("JSON values serialise") + "\n",
+    )?;
     for r in &runs {
         let n = r.summary["simulate"]["unconverged_steps"]
             .as_u64()
@@ -168,7 +213,7 @@ pub fn run(args: &RunArgs) -> Result<bool, String> {
             ))?;
         }
     }
-    Ok(true)
+    Ok(summary)
 }
 
 /// The name of a pattern argument as a folder name (`stockinette`, `my.pyp` → `my`).
@@ -178,19 +223,23 @@ fn folder_name(arg: &str) -> String {
         .map_or_else(|| arg.to_string(), |s| s.to_string_lossy().to_string())
 }
 
-fn run_pattern(args: &RunArgs, arg: &str, log: &mut Log) -> Result<PatternRun, String> {
+fn run_pattern(args: &RunConfig, arg: &str, log: &mut Log) -> Result<PatternRun, WorkflowError> {
     let name = folder_name(arg);
     let dir = args.out.join(&name);
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+    std::fs::create_dir_all(&dir).map_err(|e| WorkflowError::io(&dir, "cannot create", e))?;
     let s = |f: &str| dir.join(f).display().to_string();
     let mut stages = Vec::new();
     log.line(&format!("\n== {name}"))?;
 
     // 1. the pattern
     let t = Instant::now();
-    let pattern = load_pattern(arg)?;
+    let loaded = load_pattern(arg)?;
+    if let Some(note) = loaded.note(arg) {
+        log.event(Event::Note(&note));
+    }
+    let pattern = loaded.pattern;
     let pattern_path = dir.join("pattern.pyp");
-    pattern.save_pyp(&pattern_path).map_err(|e| e.to_string())?;
+    pattern.save_pyp(&pattern_path)?;
     let pattern_hash = format!("{:016x}", fnv1a64(pattern.to_pyp_string().as_bytes()));
     log.line(&format!(
         "pattern: {} vertices, {} yarns, periods {:.4e} × {:.4e} m, wrote {}",
@@ -204,7 +253,7 @@ fn run_pattern(args: &RunArgs, arg: &str, log: &mut Log) -> Result<PatternRun, S
 
     // 2. the reference state (C1), reused when the pattern is unchanged
     let t = Instant::now();
-    let construction = construction_of(arg, args.construction.as_deref())?;
+    let construction = construction_of(arg, args.construction)?;
     let ref_path = dir.join("reference.pyp");
     let ref_json = dir.join("reference.json");
     let reused = std::fs::read_to_string(&ref_json)
@@ -227,15 +276,14 @@ fn run_pattern(args: &RunArgs, arg: &str, log: &mut Log) -> Result<PatternRun, S
                 &SolverOptions::default(),
                 &ReferenceOptions::default(),
             )
-            .map_err(|e| format!("{name}: reference state: {e}"))?;
-            q.save_pyp(&ref_path).map_err(|e| e.to_string())?;
+            .map_err(|e| WorkflowError::Stage(format!("{name}: reference state: {e}")))?;
+            q.save_pyp(&ref_path)?;
             let v = json!({"pattern hash": pattern_hash, "construction": format!("{construction:?}"),
                            "report": report});
-            std::fs::write(
+            write_file(
                 &ref_json,
-                serde_json::to_string_pretty(&v).expect("json") + "\n",
-            )
-            .map_err(|e| format!("{}: {e}", ref_json.display()))?;
+                serde_json::to_string_pretty(&v).expect("JSON values serialise") + "\n",
+            )?;
             log.line(&format!(
                 "reference ({construction:?}): periods {:.4e} × {:.4e} m (strain {:+.2} %, {:+.2} %), \
                  Ψ̄(0) = {:.4e} J/m², wrote {}",
@@ -253,7 +301,7 @@ fn run_pattern(args: &RunArgs, arg: &str, log: &mut Log) -> Result<PatternRun, S
 
     // 3. sampling (C4): the plan and the held-out grid, resumable
     let t = Instant::now();
-    let (q, _) = Pattern::load_pyp(&ref_path).map_err(|e| e.to_string())?;
+    let (q, _) = Pattern::load_pyp(&ref_path)?;
     let problem = MicroProblem::new(q, &YarnMaterial::default(), SolverOptions::default());
     let plan = load_plan(&args.plan)?;
     let samples = dir.join("samples.jsonl");
@@ -263,7 +311,7 @@ fn run_pattern(args: &RunArgs, arg: &str, log: &mut Log) -> Result<PatternRun, S
         cold: false,
         shard: None,
         limit: None,
-        progress: true,
+        progress: args.sample_progress,
     };
     let sp = run_plan(&problem, &plan, &samples, &opts)?;
     let holdout = dir.join("holdout.jsonl");
@@ -290,20 +338,14 @@ fn run_pattern(args: &RunArgs, arg: &str, log: &mut Log) -> Result<PatternRun, S
     // 4. fitting (C5–C7)
     let t = Instant::now();
     let material = dir.join("material.json");
-    let report: FitReport = fit(
-        &samples,
-        &material,
-        &dir.join("fit.json"),
-        &dir.join("plots"),
-        FitArgs {
-            plan: None,
-            density: None,
-            holdout: vec![holdout.clone()],
-            compare: None,
-            options: FitOptions::default(),
-            plots: true,
-        },
-    )?;
+    let job = FitJob {
+        out: material.clone(),
+        report: dir.join("fit.json"),
+        plots: dir.join("plots"),
+        holdout: vec![holdout.clone()],
+        ..FitJob::beside(&samples)
+    };
+    let report: FitReport = fit_samples(&job, &mut |e| log.event(e))?;
     stages.push(("fit", t.elapsed().as_secs_f64()));
     let h = report.holdout.as_ref();
 
@@ -314,18 +356,15 @@ fn run_pattern(args: &RunArgs, arg: &str, log: &mut Log) -> Result<PatternRun, S
         duration: args.duration,
         dt: Some(args.dt),
         edge: args.edge,
-        psd: None,
-        no_bending: false,
-        only_1d: false,
-        in_plane_only: false,
-        quiet: false,
-        print: false,
+        ..Overrides::default()
     };
     let (mut scene, scene_dir) = prepare(&args.scene, &ov)?;
     // frames at 60 per simulated second whatever the step
     scene.output.obj_every = ((1.0 / 60.0) / args.dt).round().max(1.0) as usize;
     let sim_dir = dir.join("simulate");
-    let o = execute(&scene, &args.scene, &scene_dir, &sim_dir, false)?;
+    let o = execute(&scene, &args.scene, &scene_dir, &sim_dir, &mut |e| {
+        log.event(e)
+    })?;
     let png = dir.join("snapshot.png");
     snapshot(&png, &scene, &o)?;
     let line = summary_line(&o.summary);

@@ -1,0 +1,70 @@
+//! Flag groups and value types that several subcommands share.
+
+use clap::ValueEnum;
+use hylc::micro::reference::Construction;
+use hylc::micro::SolverOptions;
+use std::process::ExitCode;
+
+/// The micro solver's stopping rules (`hylc solve`, `sample`, `micro-grid`).
+#[derive(clap::Args, Clone, Debug)]
+pub struct SolverArgs {
+    /// force tolerance relative to the stretching stiffness
+    #[arg(long, default_value_t = 1e-8)]
+    pub tolerance: f64,
+    /// Newton step limit
+    #[arg(long, default_value_t = 2000)]
+    pub max_steps: usize,
+    /// wall-time limit per solve in seconds
+    #[arg(long)]
+    pub time_limit: Option<f64>,
+}
+
+impl SolverArgs {
+    /// The solver options with these stopping rules, the others at their defaults.
+    pub fn options(&self) -> SolverOptions {
+        SolverOptions {
+            tolerance: self.tolerance,
+            max_steps: self.max_steps,
+            time_limit: self.time_limit,
+            ..Default::default()
+        }
+    }
+}
+
+/// Knitted or woven (selects C1's tension factors).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ConstructionArg {
+    #[value(alias = "knit")]
+    Knitted,
+    #[value(alias = "weave")]
+    Woven,
+}
+
+impl From<ConstructionArg> for Construction {
+    fn from(c: ConstructionArg) -> Self {
+        match c {
+            ConstructionArg::Knitted => Construction::Knitted,
+            ConstructionArg::Woven => Construction::Woven,
+        }
+    }
+}
+
+/// Exit code 0 when `ok`, else `code` (e.g. 3: a solve did not converge).
+pub fn exit(ok: bool, code: u8) -> ExitCode {
+    if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(code)
+    }
+}
+
+/// A comma-separated list of values for `--what`.
+pub fn parse_list<T: std::str::FromStr>(text: &str, what: &str) -> anyhow::Result<Vec<T>> {
+    text.split(',')
+        .map(|s| {
+            s.trim()
+                .parse()
+                .map_err(|_| anyhow::anyhow!("--{what}: cannot parse {s:?} in {text:?}"))
+        })
+        .collect()
+}

@@ -1,0 +1,52 @@
+//! `hylc sensitivity PATTERN --z …`: Ψ̄ and its derivatives with respect to the strain and the yarn parameters
+//! at one strain (envelope theorem; `03-homogenization.md`, `hylc::micro::envelope`).
+
+use crate::strain::{load_pattern_noted, parse_strain};
+use hylc::micro::envelope::{
+    parameter_derivatives, strain_derivatives, strain_stiffness, PARAMETER_NAMES,
+};
+use hylc::micro::strain::STRAIN_NAMES;
+use hylc::micro::{MicroProblem, SolverOptions};
+use hylc::rod::YarnMaterial;
+use std::process::ExitCode;
+
+/// Ψ̄ at one strain with its derivatives with respect to the strain and to the yarn parameters (envelope
+/// theorem).
+#[derive(clap::Args)]
+pub struct Args {
+    /// `.pyp` file or generated kind
+    pattern: String,
+    /// strain s_x,s_a,s_y[,II00,II11]
+    #[arg(long = "z", allow_hyphen_values = true, default_value = "0,0,0")]
+    z: String,
+}
+
+pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let p = load_pattern_noted(&a.pattern)?;
+    let problem = MicroProblem::new(p, &YarnMaterial::default(), SolverOptions::default());
+    let strain = parse_strain(&a.z)?;
+    let sol = problem.solve(&strain, None)?;
+    let psi = sol.psi()?;
+    let ds = strain_derivatives(&problem, &sol.state)?;
+    let dp = parameter_derivatives(&problem, &sol)?;
+    println!("Ψ̄ = {psi:.6e} J/m² ({} steps)", sol.steps);
+    for (n, v) in STRAIN_NAMES.iter().zip(ds) {
+        match v {
+            Some(v) => println!("  ∂Ψ̄/∂{n} = {v:.6e}"),
+            None => println!("  ∂Ψ̄/∂{n}: not available (bending along the other axis)"),
+        }
+    }
+    for (n, v) in PARAMETER_NAMES.iter().zip(dp) {
+        println!("  ∂Ψ̄/∂{n} = {v:.6e}");
+    }
+    let st = strain_stiffness(&problem, &sol.state)?;
+    let names: Vec<&str> = st.components.iter().map(|&k| STRAIN_NAMES[k]).collect();
+    println!("  d²Ψ̄/dz² over ({}):", names.join(", "));
+    for i in 0..names.len() {
+        let row: Vec<String> = (0..names.len())
+            .map(|j| format!("{:>13.5e}", st.hessian[(i, j)]))
+            .collect();
+        println!("    {}", row.join(" "));
+    }
+    Ok(ExitCode::SUCCESS)
+}

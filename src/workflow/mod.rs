@@ -1,0 +1,88 @@
+//! Workflows: the stages of `../shared/seed/hylc_pseudocode.txt` put together the way the command line runs them
+//! (`../shared/design/01-architecture.md`, "Command line"), as library functions that the `hylc` binary, the
+//! tests and the Python module share:
+//!
+//! - [`inputs`]: a pattern, a construction or a sampling plan from a command-line style argument;
+//! - [`sidecar`]: the `SAMPLES.meta.json` file beside a sample file (plan, pattern, yarn, solver, density);
+//! - [`fit`]: Algorithm C5 on a sample file, with the material, the JSON report and the plots written;
+//! - [`simulate`]: a cloth scene (C8) with overrides, its frames, log and PNG snapshot;
+//! - [`pipeline`]: the main job `hylc run` (C1 → C4 → C5–C7 → C8) end to end.
+//!
+//! Nothing here prints: what a terminal would show goes to an [`Event`] callback.
+
+pub mod fit;
+pub mod inputs;
+pub mod pipeline;
+pub mod sidecar;
+pub mod simulate;
+
+use std::path::{Path, PathBuf};
+
+/// What a workflow reports while it runs; the `hylc` binary prints the lines and draws a progress bar.
+#[derive(Clone, Copy, Debug)]
+pub enum Event<'a> {
+    /// A line of the run log (`hylc run` also keeps it in `run.log`).
+    Log(&'a str),
+    /// A line of terminal output that is not part of the run log (e.g. the fit's error table).
+    Print(&'a str),
+    /// A note or warning (the binary writes it to stderr).
+    Note(&'a str),
+    /// A cloth time step finished: `done` of `total` steps, simulated time, Newton iterations, final residual.
+    Step {
+        done: usize,
+        total: usize,
+        time: f64,
+        newton: usize,
+        residual: f64,
+    },
+}
+
+/// Errors of the workflows: the stage's own error, or a file that could not be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum WorkflowError {
+    /// A file or folder operation failed.
+    #[error("{}: {action}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        action: &'static str,
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Pattern(#[from] crate::pattern::PatternError),
+    #[error(transparent)]
+    Generate(#[from] crate::generate::GenerateError),
+    #[error(transparent)]
+    Plan(#[from] crate::sample::plan::PlanError),
+    #[error(transparent)]
+    Material(#[from] crate::material::json::MaterialError),
+    #[error(transparent)]
+    Shell(#[from] crate::shell::ShellError),
+    /// A stage that reports its errors as text (sampling, plots).
+    #[error("{0}")]
+    Stage(String),
+    /// Bad input to a workflow, with the argument or file at fault.
+    #[error("{0}")]
+    Input(String),
+}
+
+impl WorkflowError {
+    /// An I/O error on `path` while doing `action` ("cannot read", "cannot write", …).
+    pub fn io(path: &Path, action: &'static str, source: std::io::Error) -> Self {
+        WorkflowError::Io {
+            path: path.to_path_buf(),
+            action,
+            source,
+        }
+    }
+}
+
+impl From<String> for WorkflowError {
+    fn from(s: String) -> Self {
+        WorkflowError::Stage(s)
+    }
+}
+
+/// Write `text` to `path`, naming the file on failure.
+pub(crate) fn write_file(path: &Path, text: impl AsRef<[u8]>) -> Result<(), WorkflowError> {
+    std::fs::write(path, text).map_err(|e| WorkflowError::io(path, "cannot write", e))
+}

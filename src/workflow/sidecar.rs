@@ -1,0 +1,60 @@
+//! The sidecar of a sample file (`samples.jsonl` → `samples.meta.json`): the plan, the pattern (its `.pyp` text),
+//! the yarn parameters, the solver settings, the problem hash and the pattern's areal density, which the fit reads
+//! (`04-sampling-fitting.md`, "Sampling plan (C4)").
+
+use super::{write_file, WorkflowError};
+use crate::micro::MicroProblem;
+use crate::sample::plan::fnv1a64;
+use crate::sample::run::problem_hash;
+use crate::sample::Plan;
+use std::path::{Path, PathBuf};
+
+/// The sidecar's path: `samples.jsonl` → `samples.meta.json`.
+pub fn meta_path(samples: &Path) -> PathBuf {
+    samples.with_extension("meta.json")
+}
+
+/// Write the sidecar of the sample file `out`; `arg` is the pattern as the user named it.
+pub fn write_meta(
+    out: &Path,
+    arg: &str,
+    plan: &Plan,
+    problem: &MicroProblem,
+) -> Result<(), WorkflowError> {
+    let m = &problem.material;
+    let pyp = problem.pattern.to_pyp_string();
+    let meta = serde_json::json!({
+        "pattern": arg,
+        "pyp hash": format!("{:016x}", fnv1a64(pyp.as_bytes())),
+        "problem": problem_hash(problem),
+        "plan": plan,
+        "density": problem.pattern.areal_density(m.density),
+        "yarn": {
+            "young": m.young, "shear": m.shear, "bend_twist_factor": m.bend_twist_factor, "radius": m.radius,
+            "density": m.density, "contact_stiffness": m.contact_stiffness,
+            "contact_quadrature": m.contact_quadrature, "contact_exclusion": m.contact_exclusion,
+        },
+        "solver": problem.options,
+        "periods": problem.pattern.periods,
+        "pyp": pyp,
+    });
+    let text = serde_json::to_string_pretty(&meta).expect("JSON values serialise");
+    write_file(&meta_path(out), text + "\n")
+}
+
+/// The sidecar of a sample file, if there is one.
+pub fn read_meta(
+    samples: &Path,
+) -> Result<Option<serde_json::Map<String, serde_json::Value>>, WorkflowError> {
+    let path = meta_path(samples);
+    let bad = |what: String| WorkflowError::Input(format!("{}: {what}", path.display()));
+    match std::fs::read_to_string(&path) {
+        Ok(text) => match serde_json::from_str::<serde_json::Value>(&text) {
+            Ok(serde_json::Value::Object(m)) => Ok(Some(m)),
+            Ok(_) => Err(bad("expected a JSON object".into())),
+            Err(e) => Err(bad(format!("not JSON: {e}"))),
+        },
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(WorkflowError::io(&path, "cannot read", e)),
+    }
+}

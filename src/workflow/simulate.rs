@@ -1,0 +1,161 @@
+//! A cloth scene (Algorithm C8; `05-macro.md`, `crate::shell::scene`) with command-line style overrides: its
+//! frames (`frame_NNNN.obj`), its step log (`log.jsonl`) and a PNG snapshot of the final state.
+
+use super::{Event, WorkflowError};
+use crate::shell::render::{sphere_mesh, write_png, Layer, View};
+use crate::shell::scene::{run, MeshSpec, RunSummary, Scene};
+use crate::shell::solver::Obstacle;
+use crate::shell::Psd;
+use std::path::{Path, PathBuf};
+
+/// Overrides of a scene's settings (each `None`/`false` keeps the scene's).
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    /// A material file (relative to the working directory) or `default`.
+    pub material: Option<String>,
+    pub duration: Option<f64>,
+    pub dt: Option<f64>,
+    /// The edge length of a rectangle mesh.
+    pub edge: Option<f64>,
+    pub psd: Option<Psd>,
+    pub no_bending: bool,
+    pub only_1d: bool,
+    pub in_plane_only: bool,
+}
+
+/// The scene `scene_arg` (a JSON file or a built-in) after the overrides, with the folder its relative paths
+/// start from.
+pub fn prepare(scene_arg: &str, ov: &Overrides) -> Result<(Scene, PathBuf), WorkflowError> {
+    let (mut scene, dir) = Scene::load(scene_arg)?;
+    if let Some(m) = &ov.material {
+        // a path given on the command line is relative to the working directory
+        scene.material = if m == "default" {
+            m.clone()
+        } else {
+            std::fs::canonicalize(m)
+                .map_err(|e| WorkflowError::Input(format!("--material {m}: {e}")))?
+                .display()
+                .to_string()
+        };
+    }
+    if let Some(d) = ov.duration {
+        scene.duration = d;
+    }
+    if let Some(dt) = ov.dt {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(WorkflowError::Input(format!(
+                "--dt {dt}: expected a positive step (s)"
+            )));
+        }
+        scene.dt = dt;
+    }
+    if let Some(e) = ov.edge {
+        match &mut scene.mesh {
+            MeshSpec::Rectangle { edge, .. } => *edge = e,
+            _ => {
+                return Err(WorkflowError::Input(
+                    "--edge applies to rectangle meshes only".into(),
+                ))
+            }
+        }
+    }
+    if let Some(p) = ov.psd {
+        scene.psd = p;
+    }
+    scene.model.bending &= !ov.no_bending;
+    scene.model.only_1d |= ov.only_1d;
+    scene.model.in_plane_only |= ov.in_plane_only;
+    Ok((scene, dir))
+}
+
+/// The end state of a simulation: its summary, the final positions and the triangles.
+pub struct Outcome {
+    pub summary: RunSummary,
+    pub positions: Vec<[f64; 3]>,
+    pub triangles: Vec<[usize; 3]>,
+}
+
+/// Build and run a scene, writing the frames and the log to `out`; reports the scene as an [`Event::Print`]
+/// line and every step as an [`Event::Step`].
+pub fn execute(
+    scene: &Scene,
+    scene_arg: &str,
+    dir: &Path,
+    out: &Path,
+    on_event: &mut dyn FnMut(Event),
+) -> Result<Outcome, WorkflowError> {
+    let (mut sim, tris) = scene.build(scene_arg, dir)?;
+    let steps = scene.steps();
+    on_event(Event::Print(&format!(
+        "scene {scene_arg}: {} triangles, {} vertices, {} free dofs, {} steps of {:.4} s{}; output in {}",
+        tris.len(),
+        sim.pattern.n,
+        3 * sim.pattern.nfree,
+        steps,
+        scene.dt,
+        if scene.quasi_static { " (quasi-static)" } else { "" },
+        out.display()
+    )));
+    let mut done = 0;
+    let summary = run(
+        &mut sim,
+        &tris,
+        steps,
+        scene.output.obj_every,
+        Some(out),
+        |r| {
+            done += 1;
+            on_event(Event::Step {
+                done,
+                total: steps,
+                time: r.time,
+                newton: r.newton,
+                residual: r.residual,
+            });
+        },
+    )?;
+    Ok(Outcome {
+        summary,
+        positions: sim.positions(),
+        triangles: tris,
+    })
+}
+
+/// Write a PNG snapshot of the cloth (blue-grey) with the scene's sphere obstacles (light grey).
+pub fn snapshot(path: &Path, scene: &Scene, o: &Outcome) -> Result<(), WorkflowError> {
+    let spheres: Vec<_> = scene
+        .obstacles
+        .iter()
+        .filter_map(|ob| match ob {
+            Obstacle::Sphere { center, radius } => Some(sphere_mesh(*center, *radius, 48)),
+            Obstacle::Plane { .. } => None,
+        })
+        .collect();
+    let mut layers = vec![Layer {
+        positions: &o.positions,
+        triangles: &o.triangles,
+        color: [70, 110, 170],
+    }];
+    for (x, t) in &spheres {
+        layers.push(Layer {
+            positions: x,
+            triangles: t,
+            color: [215, 215, 205],
+        });
+    }
+    Ok(write_png(path, &layers, &View::default())?)
+}
+
+/// One-line summary of a finished run.
+pub fn summary_line(s: &RunSummary) -> String {
+    format!(
+        "{} steps in {:.2} s wall ({:.3} s per step); Newton iterations: {} total, {} at most; {} steps not converged; largest final residual {:.2e} N",
+        s.steps,
+        s.wall,
+        s.wall / s.steps.max(1) as f64,
+        s.newton_total,
+        s.newton_max,
+        s.unconverged_steps,
+        s.max_residual
+    )
+}
