@@ -123,7 +123,7 @@ proptest! {
         let kb = if x_bending { 3 } else { 4 };
         m.constant = 0.0;
         m.terms2d.clear();
-        m.terms1d.retain(|t| t.k == kb);
+        m.terms1d.retain(|t| t.strain.index() == kb);
         m.terms1d[0].spline = s.clone();
         m.strain_scale[kb] = 1.0;
         let psi = m.eval(&[0.0, 0.0, 0.0, l00, l01, l11]).value;
@@ -138,7 +138,7 @@ proptest! {
         prop_assert!((b - psi).abs() <= 1e-11 * scale * (1.0 + l00.abs() + l01.abs() + l11.abs()), "{b} vs {psi}");
         // swapping the axes (L00 ↔ L11) exchanges the 00 and 11 components, i.e. the eigenvector roles
         let mut swapped = m.clone();
-        swapped.terms1d[0].k = 7 - kb;
+        swapped.terms1d[0].strain = hylc::strain::StrainComponent::ALL[7 - kb];
         swapped.strain_scale[7 - kb] = 1.0;
         let psi_swapped = swapped.eval(&[0.0, 0.0, 0.0, l11, l01, l00]).value;
         prop_assert!(close(psi, psi_swapped, 1e-12), "{psi} vs {psi_swapped}");
@@ -201,7 +201,7 @@ fn parts(m: &Material) -> Vec<Material> {
     for t in &m.terms1d {
         let mut p = m.clone();
         p.constant = 0.0;
-        p.terms1d.retain(|u| u.k == t.k);
+        p.terms1d.retain(|u| u.strain == t.strain);
         p.terms2d.clear();
         out.push(p);
     }
@@ -209,7 +209,7 @@ fn parts(m: &Material) -> Vec<Material> {
         let mut p = m.clone();
         p.constant = 0.0;
         p.terms1d.clear();
-        p.terms2d.retain(|u| u.k0 == t.k0 && u.k1 == t.k1);
+        p.terms2d.retain(|u| u.strains == t.strains);
         out.push(p);
     }
     out

@@ -65,7 +65,7 @@ impl StrainComponent {
 
 impl fmt::Display for StrainComponent {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
+        f.pad(self.name())
     }
 }
 
@@ -152,6 +152,10 @@ mod tests {
             assert_eq!(serde_json::to_string(&c).unwrap(), format!("\"{c}\""));
         }
         assert_eq!(StrainComponent::II11.index(), 4);
+        assert_eq!(
+            format!("{:<6}|{:>5}", StrainComponent::Sx, StrainComponent::II00),
+            "s_x   | II00"
+        );
         assert_eq!(StrainComponent::II11.index6(), 5);
         assert_eq!(StrainComponent::from_index(5), None);
         assert!("II01".parse::<StrainComponent>().is_err());

@@ -9,7 +9,7 @@ use common::cli_error;
 use hylc::fit::model::strain6;
 use hylc::material::synthetic::default_material;
 use hylc::material::Material;
-use hylc::sample::{InPlaneGrid, Plan, Record};
+use hylc::sample::{InPlaneGrid, Plan, Record, SampleStart, SampleStatus};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -41,12 +41,16 @@ fn write_samples(
             z: s.z,
             psi: ok.then_some(e.value),
             stress: ok.then_some([Some(g[0]), Some(g[1]), Some(g[2]), Some(g[3]), Some(g[5])]),
-            status: if ok { "Converged" } else { "MaxSteps" }.into(),
+            status: if ok {
+                SampleStatus::Converged
+            } else {
+                SampleStatus::MaxSteps
+            },
             error: None,
             steps: 1,
             gradient_norm: Some(0.0),
             time: 0.0,
-            start: "cold".into(),
+            start: SampleStart::Cold,
             problem: "0000000000000000".into(),
         };
         text += &serde_json::to_string(&r).unwrap();

@@ -8,7 +8,8 @@ use common::cli_error;
 use hylc::generate::default_pattern;
 use hylc::micro::{MicroProblem, SolverOptions};
 use hylc::rod::YarnMaterial;
-use hylc::sample::{merge, read_samples, run_plan, Plan, Record, RunOptions};
+use hylc::sample::{merge, read_samples, run_plan, Plan, Record, RunOptions, SampleStart};
+use hylc::strain::StrainComponent::{Sa, Sx, Sy, II00};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -24,7 +25,7 @@ fn tiny_plan() -> Plan {
     let mut p = Plan::reduced();
     p.count_1d = 4;
     p.count_2d = 3;
-    p.pairs = vec![["s_x".into(), "s_a".into()], ["s_y".into(), "II00".into()]];
+    p.pairs = vec![[Sx, Sa], [Sy, II00]];
     p
 }
 
@@ -82,7 +83,7 @@ fn resume_after_truncation_writes_the_same_records() {
         full.values().all(|r| r.psi.is_some()),
         "the tiny plan converges everywhere"
     );
-    assert!(full.values().any(|r| r.start == "predicted"));
+    assert!(full.values().any(|r| r.start == SampleStart::Predicted));
 
     // cut the file in the middle of a line, then resume
     let text = std::fs::read(d.join("full.jsonl")).expect("read");
@@ -179,7 +180,7 @@ fn cold_start_solves_every_sample_from_the_reference_state() {
     };
     let cold = run(&problem, &plan, &d.join("cold.jsonl"), opts);
     assert_eq!(cold.len(), plan.len());
-    assert!(cold.values().all(|r| r.start == "cold"));
+    assert!(cold.values().all(|r| r.start == SampleStart::Cold));
     std::fs::remove_dir_all(&d).ok();
 }
 

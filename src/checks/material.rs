@@ -173,8 +173,9 @@ impl PsiCheck {
     pub fn only(m: &Material, one: &[usize], two: &[(usize, usize)]) -> Material {
         let mut s = m.clone();
         s.constant = 0.0;
-        s.terms1d.retain(|t| one.contains(&t.k));
-        s.terms2d.retain(|t| two.contains(&(t.k0, t.k1)));
+        s.terms1d.retain(|t| one.contains(&t.strain.index()));
+        s.terms2d
+            .retain(|t| two.contains(&(t.strains[0].index(), t.strains[1].index())));
         s
     }
 }
@@ -196,11 +197,13 @@ impl Differentiable for PsiCheck {
         let mut sigma = f64::INFINITY;
         for t in &m.terms1d {
             v += max_abs(&t.spline.p);
-            sigma = sigma.min(m.strain_scale[t.k]);
+            sigma = sigma.min(m.strain_scale[t.strain.index()]);
         }
         for t in &m.terms2d {
             v += max_abs(&t.spline.p);
-            sigma = sigma.min(m.strain_scale[t.k0]).min(m.strain_scale[t.k1]);
+            for c in t.strains {
+                sigma = sigma.min(m.strain_scale[c.index()]);
+            }
         }
         data_scales(v, sigma)
     }

@@ -22,8 +22,8 @@ use super::fit1d::{fit1d_with_stress, Fit1D, Fit1DOptions, MinimumAt, SlopeSourc
 use super::fit2d::{fit2d, Fit2D, Fit2DOptions};
 use super::FitError;
 use crate::material::{Material, Term1D, Term2D};
-use crate::micro::strain::STRAIN_NAMES;
 use crate::sample::{Plan, Record};
+use crate::strain::StrainComponent;
 use serde::Serialize;
 
 /// Options of the whole fit; [`Default`] gives the design's defaults.
@@ -105,7 +105,7 @@ pub struct ModelError {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Term1DReport {
     pub k: usize,
-    pub strain: String,
+    pub strain: StrainComponent,
     /// samples used / excluded (failed)
     pub n_samples: usize,
     pub n_excluded: usize,
@@ -124,7 +124,7 @@ pub struct Term1DReport {
 pub struct Term2DReport {
     pub k0: usize,
     pub k1: usize,
-    pub strains: [String; 2],
+    pub strains: [StrainComponent; 2],
     pub n_samples: usize,
     pub n_excluded: usize,
     /// FIT2D's unconverted spline against Ψ̄
@@ -223,7 +223,7 @@ pub fn fit_material(
         return Err(FitError::BadOption(format!(
             "the plan has {} samples on the 1D range of {}; fitting needs at least 3",
             plan.n_1d(k),
-            STRAIN_NAMES[k]
+            StrainComponent::NAMES[k]
         )));
     }
     let n = plan.len();
@@ -291,7 +291,11 @@ pub fn fit_material(
             slopes: opts.slopes,
         };
         let fit = fit1d_with_stress(&x, &psi, Some(&stress), &o).map_err(|e| {
-            FitError::BadOption(format!("1D term {} ({}): {e}", k, STRAIN_NAMES[k]))
+            FitError::BadOption(format!(
+                "1D term {} ({}): {e}",
+                k,
+                StrainComponent::NAMES[k]
+            ))
         })?;
         fits1d.push((k, fit, TermData { x, y: vec![], psi }));
     }
@@ -322,10 +326,7 @@ pub fn fit_material(
     // 2D terms
     let mut fits2d = Vec::new();
     for (p, [a, b]) in plan.pairs.iter().enumerate() {
-        let (ka, kb) = (
-            crate::sample::plan::strain_index(a).unwrap_or(0),
-            crate::sample::plan::strain_index(b).unwrap_or(0),
-        );
+        let (ka, kb) = (a.index(), b.index());
         let (k0, k1) = (ka.min(kb), ka.max(kb));
         let idx: Vec<usize> = plan.range_2d(p).collect();
         let x: Vec<f64> = idx.iter().map(|&i| samples[i].z[k0] / sigma[k0]).collect();
@@ -361,7 +362,8 @@ pub fn fit_material(
         let fit = fit2d(&x, &y, &psi, &o).map_err(|e| {
             FitError::BadOption(format!(
                 "2D term ({}, {}): {e}",
-                STRAIN_NAMES[k0], STRAIN_NAMES[k1]
+                StrainComponent::NAMES[k0],
+                StrainComponent::NAMES[k1]
             ))
         })?;
         fits2d.push((k0, k1, fit, TermData { x, y, psi }));
@@ -374,15 +376,14 @@ pub fn fit_material(
         terms1d: fits1d
             .iter()
             .map(|(k, f, _)| Term1D {
-                k: *k,
+                strain: StrainComponent::ALL[*k],
                 spline: f.spline.clone(),
             })
             .collect(),
         terms2d: fits2d
             .iter()
             .map(|(k0, k1, f, _)| Term2D {
-                k0: *k0,
-                k1: *k1,
+                strains: [StrainComponent::ALL[*k0], StrainComponent::ALL[*k1]],
                 spline: f.residual.clone(),
             })
             .collect(),
@@ -397,7 +398,7 @@ pub fn fit_material(
         .iter()
         .map(|(k, f, _)| Term1DReport {
             k: *k,
-            strain: STRAIN_NAMES[*k].to_string(),
+            strain: StrainComponent::ALL[*k],
             n_samples: f.report.n_samples,
             n_excluded: f.report.n_excluded,
             fit_rms_rel: f.report.rms_rel,
@@ -413,7 +414,7 @@ pub fn fit_material(
         .map(|(p, (k0, k1, f, _))| Term2DReport {
             k0: *k0,
             k1: *k1,
-            strains: [STRAIN_NAMES[*k0].to_string(), STRAIN_NAMES[*k1].to_string()],
+            strains: [StrainComponent::ALL[*k0], StrainComponent::ALL[*k1]],
             n_samples: f.report.n_samples,
             n_excluded: f.report.n_excluded,
             fit_rms_rel: f.report.rms_rel,
@@ -492,7 +493,7 @@ pub fn fit_material(
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RangeComparison {
     pub k: usize,
-    pub strain: String,
+    pub strain: StrainComponent,
     /// points compared (the plan's values of the range inside the other material's sampled range)
     pub n_points: usize,
     /// the compared interval of strain k
@@ -543,7 +544,7 @@ pub fn compare_1d(
     let mut out = Vec::new();
     let mut values: Vec<Vec<(f64, f64)>> = Vec::new();
     for k in 0..5 {
-        let Some(term) = other.terms1d.iter().find(|t| t.k == k) else {
+        let Some(term) = other.terms1d.iter().find(|t| t.strain.index() == k) else {
             continue;
         };
         let t = &term.spline.t;
@@ -573,7 +574,7 @@ pub fn compare_1d(
         let oo: f64 = pts.iter().map(|(o, _)| o * o).sum();
         out.push(RangeComparison {
             k,
-            strain: STRAIN_NAMES[k].to_string(),
+            strain: StrainComponent::ALL[k],
             n_points: pts.len(),
             interval,
             fit_rms_rel: rel(d2, o2),

@@ -5,7 +5,7 @@
 use super::fit1d::Fit1D;
 use super::fit2d::Fit2D;
 use super::model::{MaterialFit, TermData};
-use crate::micro::strain::STRAIN_NAMES;
+use crate::strain::StrainComponent;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -60,7 +60,10 @@ pub fn plot_term1d(
     root.fill(&WHITE).map_err(&e)?;
     let title = format!(
         "f0 + f_{k} ({}): {} samples, {} failed, fit RMS {:.2e}",
-        STRAIN_NAMES[k], fit.report.n_samples, failed, fit.report.rms_rel
+        StrainComponent::NAMES[k],
+        fit.report.n_samples,
+        failed,
+        fit.report.rms_rel
     );
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 22))
@@ -71,7 +74,7 @@ pub fn plot_term1d(
         .map_err(&e)?;
     chart
         .configure_mesh()
-        .x_desc(STRAIN_NAMES[k])
+        .x_desc(StrainComponent::NAMES[k])
         .y_desc("energy density [J/m2]")
         .draw()
         .map_err(&e)?;
@@ -184,7 +187,11 @@ pub fn plot_term2d(
             &full,
             format!(
                 "f({}, {}): {:.3e} to {:.3e} J/m² (log colours), fit RMS {:.2e}",
-                STRAIN_NAMES[k0], STRAIN_NAMES[k1], fmin, fmax, fit.report.rms_rel
+                StrainComponent::NAMES[k0],
+                StrainComponent::NAMES[k1],
+                fmin,
+                fmax,
+                fit.report.rms_rel
             ),
             false,
         ),
@@ -205,8 +212,8 @@ pub fn plot_term2d(
         chart
             .configure_mesh()
             .disable_mesh()
-            .x_desc(STRAIN_NAMES[k0])
-            .y_desc(STRAIN_NAMES[k1])
+            .x_desc(StrainComponent::NAMES[k0])
+            .y_desc(StrainComponent::NAMES[k1])
             .draw()
             .map_err(&e)?;
         chart
@@ -243,14 +250,15 @@ pub fn plot_material_fit(dir: &Path, fit: &MaterialFit) -> Result<Vec<PathBuf>, 
     let sigma = fit.material.strain_scale;
     let mut out = Vec::new();
     for (k, f, d) in &fit.fits1d {
-        let path = dir.join(format!("1d_{}.png", STRAIN_NAMES[*k]));
+        let path = dir.join(format!("1d_{}.png", StrainComponent::NAMES[*k]));
         plot_term1d(&path, *k, f, d, sigma[*k], fit.material.constant)?;
         out.push(path);
     }
     for (k0, k1, f, d) in &fit.fits2d {
         let path = dir.join(format!(
             "2d_{}_{}.png",
-            STRAIN_NAMES[*k0], STRAIN_NAMES[*k1]
+            StrainComponent::NAMES[*k0],
+            StrainComponent::NAMES[*k1]
         ));
         plot_term2d(&path, *k0, *k1, f, d, [sigma[*k0], sigma[*k1]])?;
         out.push(path);

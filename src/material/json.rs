@@ -9,7 +9,7 @@
 //! the tokens `NaN`, `Infinity`, `-Infinity` and numbers that overflow f64 (which some writers emit) are recognised
 //! and reported at the field where they stand.
 
-use super::{Hermite1D, Hermite2D, Material, Term1D, Term2D};
+use super::{Hermite1D, Hermite2D, Material, StrainComponent, Term1D, Term2D};
 use serde_json::{Map, Value};
 use std::fmt;
 use std::path::Path;
@@ -153,18 +153,19 @@ fn numbers(obj: &Map<String, Value>, key: &str, path: &str) -> Res<Vec<f64>> {
         .collect()
 }
 
-fn index(obj: &Map<String, Value>, key: &str, path: &str) -> Res<usize> {
+/// A strain by the file's index k = 0…4 (s_x, s_a, s_y, x-bending Π₀₀, y-bending Π₁₁).
+fn index(obj: &Map<String, Value>, key: &str, path: &str) -> Res<StrainComponent> {
     let p = join(path, key);
     let x = number(get(obj, key, path)?, &p)?;
-    if x.fract() != 0.0 || !(0.0..=4.0).contains(&x) {
-        return err(
+    match StrainComponent::from_index(x as usize) {
+        Some(c) if x.fract() == 0.0 && x >= 0.0 => Ok(c),
+        _ => err(
             &p,
             format!(
                 "unknown strain index {x} (expected 0..4: s_x, s_a, s_y, x-bending, y-bending)"
             ),
-        );
+        ),
     }
-    Ok(x as usize)
 }
 
 fn knots(obj: &Map<String, Value>, key: &str, path: &str) -> Res<Vec<f64>> {
@@ -244,19 +245,19 @@ fn parse_value(root: &Value) -> Res<Material> {
     {
         let path = format!("coeffs.1D[{i}]");
         let o = object(e, &path)?;
-        let k = index(o, "k", &path)?;
+        let strain = index(o, "k", &path)?;
         let t = knots(o, "t", &path)?;
         let n = t.len();
         let p = sized(o, "p", &path, n, "one per knot")?;
         let m = sized(o, "m", &path, n, "one per knot")?;
-        if terms1d.iter().any(|x| x.k == k) {
+        if terms1d.iter().any(|x| x.strain == strain) {
             return err(
                 &format!("{path}.k"),
-                format!("duplicate 1D term for strain index {k}"),
+                format!("duplicate 1D term for strain index {}", strain.index()),
             );
         }
         terms1d.push(Term1D {
-            k,
+            strain,
             spline: Hermite1D::new(t, p, m),
         });
     }
@@ -267,15 +268,15 @@ fn parse_value(root: &Value) -> Res<Material> {
     {
         let path = format!("coeffs.2D[{i}]");
         let o = object(e, &path)?;
-        let k0 = index(o, "k0", &path)?;
-        let k1 = index(o, "k1", &path)?;
+        let strains = [index(o, "k0", &path)?, index(o, "k1", &path)?];
+        let [k0, k1] = strains.map(StrainComponent::index);
         if k0 > 2 || k1 <= k0 {
             return err(
                 &format!("{path}.k1"),
                 format!("unsupported pair ({k0}, {k1}): k0 must be in-plane (0..2) and k1 > k0"),
             );
         }
-        if terms2d.iter().any(|x| x.k0 == k0 && x.k1 == k1) {
+        if terms2d.iter().any(|x| x.strains == strains) {
             return err(
                 &format!("{path}.k1"),
                 format!("duplicate 2D term ({k0}, {k1})"),
@@ -290,8 +291,7 @@ fn parse_value(root: &Value) -> Res<Material> {
         let mv = sized(o, "mv", &path, n, &what)?;
         let muv = sized(o, "muv", &path, n, &what)?;
         terms2d.push(Term2D {
-            k0,
-            k1,
+            strains,
             spline: Hermite2D::new(tu, tv, p, mu, mv, muv),
         });
     }
@@ -356,7 +356,7 @@ impl Material {
             .iter()
             .map(|t| {
                 let mut o = Map::new();
-                o.insert("k".into(), Value::from(t.k));
+                o.insert("k".into(), Value::from(t.strain.index()));
                 o.insert("t".into(), arr(&t.spline.t));
                 o.insert("p".into(), arr(&t.spline.p));
                 o.insert("m".into(), arr(&t.spline.m));
@@ -370,8 +370,8 @@ impl Material {
             .map(|t| {
                 let s = &t.spline;
                 let mut o = Map::new();
-                o.insert("k0".into(), Value::from(t.k0));
-                o.insert("k1".into(), Value::from(t.k1));
+                o.insert("k0".into(), Value::from(t.strains[0].index()));
+                o.insert("k1".into(), Value::from(t.strains[1].index()));
                 o.insert("tu".into(), arr(&s.tu));
                 o.insert("tv".into(), arr(&s.tv));
                 o.insert("p".into(), arr(&s.p));

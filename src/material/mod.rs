@@ -21,22 +21,19 @@ use crate::real::Real;
 use hermite::{basis_piece, basis_weights, piece_from_index};
 use spectral::{spectral_00, spectral_00_reference};
 
-/// Names of the strain components, in order.
-pub const STRAIN_NAMES: [&str; 6] = ["s_x", "s_a", "s_y", "II00", "II01", "II11"];
+pub use crate::strain::{Strain6, StrainComponent};
 
-/// A 1D term f_k of the material.
+/// A 1D term f_k of the material: k is its strain (the file's index k = 0…4: s_x, s_a, s_y, Π₀₀, Π₁₁).
 #[derive(Clone, Debug)]
 pub struct Term1D {
-    /// 0 = s_x, 1 = s_a, 2 = s_y, 3 = x-bending, 4 = y-bending
-    pub k: usize,
+    pub strain: StrainComponent,
     pub spline: Hermite1D,
 }
 
-/// A 2D term f_kl of the material (k0 in-plane, k1 > k0).
+/// A 2D term f_kl of the material: strains (k, l), k in-plane, l after k.
 #[derive(Clone, Debug)]
 pub struct Term2D {
-    pub k0: usize,
-    pub k1: usize,
+    pub strains: [StrainComponent; 2],
     pub spline: Hermite2D,
 }
 
@@ -139,25 +136,27 @@ impl Material {
             hess: [[0.0; 6]; 6],
         };
         for t in &self.terms1d {
-            if t.k <= 2 {
-                let inv = 1.0 / sc[t.k];
-                let [f, f1, f2] = t.spline.eval2(z[t.k] * inv);
+            let k = t.strain.index();
+            if k <= 2 {
+                let inv = 1.0 / sc[k];
+                let [f, f1, f2] = t.spline.eval2(z[k] * inv);
                 out.value += f;
-                out.grad[t.k] += f1 * inv;
-                out.hess[t.k][t.k] += f2 * inv * inv;
+                out.grad[k] += f1 * inv;
+                out.hess[k][k] += f2 * inv * inv;
             } else {
-                let (m, d, b) = self.mdb(t.k, z);
+                let (m, d, b) = self.mdb(k, z);
                 let s = spectral_00(&t.spline, m, d, b);
-                self.add_spectral(&mut out, t.k, None, &s);
+                self.add_spectral(&mut out, k, None, &s);
             }
         }
         for t in &self.terms2d {
-            let iu = 1.0 / sc[t.k0];
-            let u = z[t.k0] * iu;
-            if t.k1 <= 2 {
-                let iv = 1.0 / sc[t.k1];
-                let [f, fu, fv, fuu, fuv, fvv] = t.spline.eval2(u, z[t.k1] * iv);
-                let (a, b) = (t.k0, t.k1);
+            let (k0, k1) = (t.strains[0].index(), t.strains[1].index());
+            let iu = 1.0 / sc[k0];
+            let u = z[k0] * iu;
+            if k1 <= 2 {
+                let iv = 1.0 / sc[k1];
+                let [f, fu, fv, fuu, fuv, fvv] = t.spline.eval2(u, z[k1] * iv);
+                let (a, b) = (k0, k1);
                 out.value += f;
                 out.grad[a] += fu * iu;
                 out.grad[b] += fv * iv;
@@ -166,9 +165,9 @@ impl Material {
                 out.hess[a][b] += fuv * iu * iv;
                 out.hess[b][a] += fuv * iu * iv;
             } else {
-                let (m, d, b) = self.mdb(t.k1, z);
+                let (m, d, b) = self.mdb(k1, z);
                 let s = spectral_00(&t.spline.at_u(u), m, d, b);
-                self.add_spectral(&mut out, t.k1, Some((t.k0, iu)), &s);
+                self.add_spectral(&mut out, k1, Some((k0, iu)), &s);
             }
         }
         out
@@ -194,10 +193,11 @@ impl Material {
             )
         };
         for t in &self.terms1d {
-            if t.k <= 2 {
-                psi += t.spline.reference(&(z[t.k].clone() / sc[t.k]));
+            let k = t.strain.index();
+            if k <= 2 {
+                psi += t.spline.reference(&(z[k].clone() / sc[k]));
             } else {
-                let (m, delta, b) = mdb(t.k);
+                let (m, delta, b) = mdb(k);
                 let sp = &t.spline;
                 let n = sp.t.len();
                 psi += spectral_00_reference(
@@ -219,12 +219,13 @@ impl Material {
             }
         }
         for t in &self.terms2d {
-            let u = z[t.k0].clone() / sc[t.k0];
+            let (k0, k1) = (t.strains[0].index(), t.strains[1].index());
+            let u = z[k0].clone() / sc[k0];
             let sp = &t.spline;
-            if t.k1 <= 2 {
-                psi += sp.reference(&u, &(z[t.k1].clone() / sc[t.k1]));
+            if k1 <= 2 {
+                psi += sp.reference(&u, &(z[k1].clone() / sc[k1]));
             } else {
-                let (m, delta, b) = mdb(t.k1);
+                let (m, delta, b) = mdb(k1);
                 let (nu, nv) = (sp.tu.len(), sp.tv.len());
                 let (iu, wu) = basis_weights(&sp.tu, &u);
                 psi += spectral_00_reference(
@@ -284,20 +285,22 @@ impl Material {
         };
         let mut dist = f64::INFINITY;
         for t in &self.terms1d {
-            if t.k <= 2 {
-                dist = dist.min(near(&t.spline.t, z[t.k] / sc[t.k]) * sc[t.k]);
+            let k = t.strain.index();
+            if k <= 2 {
+                dist = dist.min(near(&t.spline.t, z[k] / sc[k]) * sc[k]);
             } else {
-                let (l1, l2, s) = eig(t.k);
+                let (l1, l2, s) = eig(k);
                 dist = dist.min(0.5 * s * near(&t.spline.t, l1).min(near(&t.spline.t, l2)));
             }
         }
         for t in &self.terms2d {
+            let (k0, k1) = (t.strains[0].index(), t.strains[1].index());
             let sp = &t.spline;
-            dist = dist.min(near(&sp.tu, z[t.k0] / sc[t.k0]) * sc[t.k0]);
-            if t.k1 <= 2 {
-                dist = dist.min(near(&sp.tv, z[t.k1] / sc[t.k1]) * sc[t.k1]);
+            dist = dist.min(near(&sp.tu, z[k0] / sc[k0]) * sc[k0]);
+            if k1 <= 2 {
+                dist = dist.min(near(&sp.tv, z[k1] / sc[k1]) * sc[k1]);
             } else {
-                let (l1, l2, s) = eig(t.k1);
+                let (l1, l2, s) = eig(k1);
                 dist = dist.min(0.5 * s * near(&sp.tv, l1).min(near(&sp.tv, l2)));
             }
         }
@@ -313,15 +316,15 @@ impl Material {
             hi = hi.max(t[t.len() - 1] * s);
         };
         for t in &self.terms1d {
-            if t.k == k {
+            if t.strain.index() == k {
                 upd(&t.spline.t, self.strain_scale[k]);
             }
         }
         for t in &self.terms2d {
-            if t.k0 == k {
+            if t.strains[0].index() == k {
                 upd(&t.spline.tu, self.strain_scale[k]);
             }
-            if t.k1 == k {
+            if t.strains[1].index() == k {
                 upd(&t.spline.tv, self.strain_scale[k]);
             }
         }

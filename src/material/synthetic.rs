@@ -7,7 +7,7 @@
 //! sampled at its knots with exact values and slopes, in the original's file layout (same knot counts, residual
 //! 2D terms that vanish on both axes).
 
-use super::{Hermite1D, Hermite2D, Material, Term1D, Term2D};
+use super::{Hermite1D, Hermite2D, Material, StrainComponent, Term1D, Term2D};
 use serde_json::{json, Map};
 
 /// f and f′ of each closed-form 1D term, in normalised units x = z_k/σ_k.
@@ -69,7 +69,7 @@ pub fn default_material() -> Material {
             let t = line(k, 11);
             let (p, m): (Vec<f64>, Vec<f64>) = t.iter().map(|&x| term1d(k, x)).unzip();
             Term1D {
-                k,
+                strain: StrainComponent::ALL[k],
                 spline: Hermite1D::new(t, p, m),
             }
         })
@@ -103,8 +103,7 @@ pub fn default_material() -> Material {
             }
             let [p, mu, mv, muv] = arrs;
             Term2D {
-                k0,
-                k1,
+                strains: [StrainComponent::ALL[k0], StrainComponent::ALL[k1]],
                 spline: Hermite2D::new(tu, tv, p, mu, mv, muv),
             }
         })

@@ -4,8 +4,7 @@
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
-/// Names of the five strain components, in order.
-pub const STRAIN_NAMES: [&str; 5] = ["s_x", "s_a", "s_y", "II00", "II11"];
+pub use crate::strain::StrainComponent;
 
 /// A macro strain z = (s_x, s_a, s_y, Π₀₀, Π₁₁): stretches along ξ₁ and ξ₂, the cosine of the angle between the
 /// stretched material axes, and the curvatures (1/m) of bending along ξ₁ and along ξ₂.
@@ -70,7 +69,7 @@ impl MacroStrain {
             })
         };
         if let Some(k) = z.iter().position(|v| !v.is_finite()) {
-            return err(format!("{} is not finite", STRAIN_NAMES[k]));
+            return err(format!("{} is not finite", StrainComponent::NAMES[k]));
         }
         if 1.0 + z[0] <= 0.0 {
             return err(format!("1 + s_x = {} must be positive", 1.0 + z[0]));

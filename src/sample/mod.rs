@@ -7,4 +7,7 @@ pub mod run;
 pub mod scene;
 
 pub use plan::{sample_range, Chain, InPlaneGrid, Plan, PlanError, Sample, Step};
-pub use run::{merge, parse_shard, read_samples, run_plan, Record, RunOptions, RunSummary};
+pub use run::{
+    merge, parse_shard, read_samples, run_plan, Record, RunOptions, RunSummary, SampleStart,
+    SampleStatus,
+};

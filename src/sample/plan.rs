@@ -7,7 +7,7 @@
 //! from the sample nearest z = 0; each 2D grid first solves its axis (the column nearest zero in the second
 //! strain) as two rays from the point nearest the origin, then continues every row as two rays from that axis.
 
-use crate::micro::strain::STRAIN_NAMES;
+use crate::strain::StrainComponent;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::Path;
@@ -88,8 +88,8 @@ pub struct Plan {
     pub count_1d: usize,
     /// Samples per axis of each 2D grid (default 50, i.e. 50×50).
     pub count_2d: usize,
-    /// The strain pairs of the 2D grids, by name (`s_x`, `s_a`, `s_y`, `II00`, `II11`).
-    pub pairs: Vec<[String; 2]>,
+    /// The strain pairs of the 2D grids (written by name: `s_x`, `s_a`, `s_y`, `II00`, `II11`).
+    pub pairs: Vec<[StrainComponent; 2]>,
     /// Optional ranges of the 2D grids, one [[min, max], [min, max]] per pair (Algorithm C4 takes 2D ranges
     /// separately from the 1D ones; the original materials' grids span e.g. s_x ∈ [−0.1, 0.84] where their 1D
     /// range reaches −0.64). Absent (the default): the grids use `ranges`. Each must contain 0.
@@ -145,19 +145,39 @@ impl InPlaneGrid {
 }
 
 /// The design's nine pairs: {s_x,s_a,s_y}² unordered distinct, then {s_x,s_a,s_y}×{Π₀₀,Π₁₁}.
-pub fn default_pairs() -> Vec<[String; 2]> {
-    let p = |a: &str, b: &str| [a.to_string(), b.to_string()];
+pub fn default_pairs() -> Vec<[StrainComponent; 2]> {
+    use StrainComponent::*;
     vec![
-        p("s_x", "s_a"),
-        p("s_x", "s_y"),
-        p("s_a", "s_y"),
-        p("s_x", "II00"),
-        p("s_x", "II11"),
-        p("s_a", "II00"),
-        p("s_a", "II11"),
-        p("s_y", "II00"),
-        p("s_y", "II11"),
+        [Sx, Sa],
+        [Sx, Sy],
+        [Sa, Sy],
+        [Sx, II00],
+        [Sx, II11],
+        [Sa, II00],
+        [Sa, II11],
+        [Sy, II00],
+        [Sy, II11],
     ]
+}
+
+/// The message for a pair that does not name two different strains.
+fn different_strains(a: &str, b: &str) -> String {
+    format!(
+        "[{a:?}, {b:?}] must name two different strains of {}",
+        StrainComponent::NAMES.join(", ")
+    )
+}
+
+/// The pairs of a plan file by name, or the field at fault (`pairs[i]`) with the message.
+fn parse_pairs(names: Vec<[String; 2]>) -> Result<Vec<[StrainComponent; 2]>, (String, String)> {
+    names
+        .iter()
+        .enumerate()
+        .map(|(i, [a, b])| match (a.parse(), b.parse()) {
+            (Ok(ka), Ok(kb)) => Ok([ka, kb]),
+            _ => Err((format!("pairs[{i}]"), different_strains(a, b))),
+        })
+        .collect()
 }
 
 impl Default for Plan {
@@ -229,11 +249,6 @@ pub fn fnv1a64(bytes: &[u8]) -> u64 {
         h = h.wrapping_mul(0x0100_0000_01b3);
     }
     h
-}
-
-/// The index of a strain name (`s_x` 0, `s_a` 1, `s_y` 2, `II00` 3, `II11` 4).
-pub fn strain_index(name: &str) -> Option<usize> {
-    STRAIN_NAMES.iter().position(|n| *n == name)
 }
 
 /// Indices of `values` ordered as two rays outward from the value nearest 0: the nearest index first, then
@@ -376,7 +391,7 @@ impl Plan {
             field,
             message,
         };
-        for (k, name) in STRAIN_NAMES.iter().enumerate() {
+        for (k, name) in StrainComponent::NAMES.iter().enumerate() {
             let [lo, hi] = self.ranges.get(k);
             if !lo.is_finite() || !hi.is_finite() || lo > hi {
                 return Err(err(
@@ -414,7 +429,7 @@ impl Plan {
             }
             for (p, sides) in r2.iter().enumerate() {
                 for (side, &[lo, hi]) in sides.iter().enumerate() {
-                    let k = strain_index(&self.pairs[p][side]).unwrap_or(1);
+                    let k = self.pairs[p][side].index();
                     if !(lo.is_finite() && hi.is_finite() && lo <= 0.0 && 0.0 <= hi)
                         || ((k == 0 || k == 2) && lo <= -1.0)
                     {
@@ -446,36 +461,26 @@ impl Plan {
             }
         }
         for (i, [a, b]) in self.pairs.iter().enumerate() {
-            let ka = strain_index(a);
-            let kb = strain_index(b);
-            match (ka, kb) {
-                (Some(ka), Some(kb)) if ka != kb => {
-                    if self.pairs[..i]
-                        .iter()
-                        .any(|[c, d]| (c == a && d == b) || (c == b && d == a))
-                    {
-                        return Err(err(
-                            format!("pairs[{i}]"),
-                            format!("[{a:?}, {b:?}] is listed twice"),
-                        ));
-                    }
-                    if ka >= 3 && kb >= 3 {
-                        return Err(err(
-                            format!("pairs[{i}]"),
-                            "two bending strains at once are not a supported strain direction"
-                                .into(),
-                        ));
-                    }
-                }
-                _ => {
-                    return Err(err(
-                        format!("pairs[{i}]"),
-                        format!(
-                            "[{a:?}, {b:?}] must name two different strains of {}",
-                            STRAIN_NAMES.join(", ")
-                        ),
-                    ))
-                }
+            if a == b {
+                return Err(err(
+                    format!("pairs[{i}]"),
+                    different_strains(a.name(), b.name()),
+                ));
+            }
+            if self.pairs[..i]
+                .iter()
+                .any(|[c, d]| (c == a && d == b) || (c == b && d == a))
+            {
+                return Err(err(
+                    format!("pairs[{i}]"),
+                    format!("[{:?}, {:?}] is listed twice", a.name(), b.name()),
+                ));
+            }
+            if !a.is_in_plane() && !b.is_in_plane() {
+                return Err(err(
+                    format!("pairs[{i}]"),
+                    "two bending strains at once are not a supported strain direction".into(),
+                ));
             }
         }
         Ok(())
@@ -535,15 +540,18 @@ impl Plan {
             .as_object()
             .ok_or_else(|| err("ranges", "expected an object of [min, max] pairs".into()))?;
         for key in ranges_obj.keys() {
-            if !STRAIN_NAMES.contains(&key.as_str()) {
+            if key.parse::<StrainComponent>().is_err() {
                 return Err(err(
                     &format!("ranges.{key}"),
-                    format!("unknown strain (expected {})", STRAIN_NAMES.join(", ")),
+                    format!(
+                        "unknown strain (expected {})",
+                        StrainComponent::NAMES.join(", ")
+                    ),
                 ));
             }
         }
         let mut r = [[0.0; 2]; 5];
-        for (k, name) in STRAIN_NAMES.iter().enumerate() {
+        for (k, name) in StrainComponent::NAMES.iter().enumerate() {
             r[k] = field(ranges_obj, name).map_err(|m| err(&format!("ranges.{name}"), m))?;
         }
         let plan = Plan {
@@ -556,7 +564,8 @@ impl Plan {
             },
             count_1d: field(obj, "count_1d").map_err(|m| err("count_1d", m))?,
             count_2d: field(obj, "count_2d").map_err(|m| err("count_2d", m))?,
-            pairs: field(obj, "pairs").map_err(|m| err("pairs", m))?,
+            pairs: parse_pairs(field(obj, "pairs").map_err(|m| err("pairs", m))?)
+                .map_err(|(f, m)| err(&f, m))?,
             ranges_2d: optional(obj, "ranges_2d").map_err(|m| err("ranges_2d", m))?,
             grid: optional(obj, "grid").map_err(|m| err("grid", m))?,
             counts_1d: optional(obj, "counts_1d").map_err(|m| err("counts_1d", m))?,
@@ -620,7 +629,7 @@ impl Plan {
     fn pair_indices(&self) -> Vec<[usize; 2]> {
         self.pairs
             .iter()
-            .map(|[a, b]| [strain_index(a).unwrap_or(0), strain_index(b).unwrap_or(0)])
+            .map(|[a, b]| [a.index(), b.index()])
             .collect()
     }
 
@@ -758,7 +767,7 @@ mod tests {
             .pairs
             .iter()
             .map(|[a, b]| {
-                let (ka, kb) = (strain_index(a).unwrap(), strain_index(b).unwrap());
+                let (ka, kb) = (a.index(), b.index());
                 [p.ranges.get(ka), p.ranges.get(kb)]
             })
             .collect();

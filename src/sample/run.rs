@@ -45,7 +45,7 @@ pub struct Record {
     /// solve's family is null.
     pub stress: Option<[Option<f64>; 5]>,
     /// `Converged`, `Stalled`, `MaxSteps`, `TimeLimit`, or `Error` (see `error`).
-    pub status: String,
+    pub status: SampleStatus,
     /// Why the solve could not run (bad strain, overlapping yarns, failed factorisation).
     pub error: Option<String>,
     /// Newton steps.
@@ -55,9 +55,42 @@ pub struct Record {
     /// Wall time of the solve (s).
     pub time: f64,
     /// How the solve started: `cold`, `warm` (previous equilibrium) or `predicted` (secant predictor).
-    pub start: String,
+    pub start: SampleStart,
     /// Hash of (pattern, yarn parameters, solver settings), 16 hex digits ([`problem_hash`]).
     pub problem: String,
+}
+
+/// How a sample's solve ended: the solver's [`Status`], or `Error` when it could not run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SampleStatus {
+    Converged,
+    Stalled,
+    MaxSteps,
+    TimeLimit,
+    Error,
+}
+
+impl From<Status> for SampleStatus {
+    fn from(s: Status) -> Self {
+        match s {
+            Status::Converged => SampleStatus::Converged,
+            Status::Stalled => SampleStatus::Stalled,
+            Status::MaxSteps => SampleStatus::MaxSteps,
+            Status::TimeLimit => SampleStatus::TimeLimit,
+        }
+    }
+}
+
+/// How a sample's solve started.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SampleStart {
+    /// From the reference state.
+    Cold,
+    /// From the previous equilibrium of its chain.
+    Warm,
+    /// From the secant predictor along its chain.
+    Predicted,
 }
 
 /// Options of [`run_plan`].
@@ -264,7 +297,7 @@ pub fn run_plan(
             let b = a
                 .and_then(|k| steps[k].from)
                 .filter(|&k| states[k].is_some());
-            let mut how = "cold";
+            let mut how = SampleStart::Cold;
             let predicted = match (a, b) {
                 (Some(a), Some(b)) => match (&states[b], &states[a]) {
                     (Some(sb), Some(sa)) => problem.predict(sb, sa, &strain).ok().flatten(),
@@ -273,10 +306,10 @@ pub fn run_plan(
                 _ => None,
             };
             let start = if let Some(p) = predicted.as_ref() {
-                how = "predicted";
+                how = SampleStart::Predicted;
                 Some(p)
             } else if let Some(s) = a.and_then(|a| states[a].as_ref()) {
-                how = "warm";
+                how = SampleStart::Warm;
                 Some(s)
             } else {
                 None
@@ -297,12 +330,12 @@ pub fn run_plan(
                         z: sample.z,
                         psi: sol.psi().ok(),
                         stress,
-                        status: sol.status.to_string(),
+                        status: sol.status.into(),
                         error: None,
                         steps: sol.steps,
                         gradient_norm: Some(sol.gradient_norm).filter(|g| g.is_finite()),
                         time: sol.time,
-                        start: how.into(),
+                        start: how,
                         problem: hash.clone(),
                     };
                     if ok {
@@ -316,12 +349,12 @@ pub fn run_plan(
                     z: sample.z,
                     psi: None,
                     stress: None,
-                    status: "Error".into(),
+                    status: SampleStatus::Error,
                     error: Some(e.to_string()),
                     steps: 0,
                     gradient_norm: None,
                     time: t.elapsed().as_secs_f64(),
-                    start: how.into(),
+                    start: how,
                     problem: hash.clone(),
                 },
             };
@@ -399,6 +432,27 @@ mod tests {
     }
 
     #[test]
+    fn records_keep_their_text_form_and_old_lines_load() {
+        // a line as earlier versions wrote it (status and start as plain strings)
+        let old = r#"{"id":"884175aca732b4af-18","index":18,"z":[0.1,0.0,0.0,0.0,0.0],"psi":null,"stress":null,"status":"MaxSteps","error":null,"steps":2000,"gradient_norm":0.001,"time":0.5,"start":"predicted","problem":"bb8024c6f202cb08"}"#;
+        let r: Record = serde_json::from_str(old).unwrap();
+        assert_eq!(r.status, SampleStatus::MaxSteps);
+        assert_eq!(r.start, SampleStart::Predicted);
+        assert_eq!(serde_json::to_string(&r).unwrap(), old);
+        let bad = old.replace("\"MaxSteps\"", "\"Maybe\"");
+        assert!(serde_json::from_str::<Record>(&bad).is_err());
+        for s in [
+            Status::Converged,
+            Status::Stalled,
+            Status::MaxSteps,
+            Status::TimeLimit,
+        ] {
+            let text = serde_json::to_string(&SampleStatus::from(s)).unwrap();
+            assert_eq!(text, format!("\"{s}\""));
+        }
+    }
+
+    #[test]
     fn truncated_last_line_is_cut_off() {
         let dir = std::env::temp_dir().join(format!("hylc-sample-unit-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
@@ -409,12 +463,12 @@ mod tests {
             z: [0.1, 0.0, 0.0, 0.0, 0.0],
             psi: Some(1.0 / 3.0),
             stress: Some([Some(0.5), None, Some(0.0), Some(-1e-300), None]),
-            status: "Converged".into(),
+            status: SampleStatus::Converged,
             error: None,
             steps: 3,
             gradient_norm: Some(1e-12),
             time: 0.01,
-            start: "cold".into(),
+            start: SampleStart::Cold,
             problem: "0".into(),
         };
         let line = serde_json::to_string(&r).unwrap();

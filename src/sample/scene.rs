@@ -151,7 +151,6 @@ pub fn scene_plan(base: &Plan, extent: &StrainExtent, margin: f64) -> (Plan, Sce
         fraction[k] = (spacing_coordinate(k, hi) - spacing_coordinate(k, lo))
             / (spacing_coordinate(k, bhi) - spacing_coordinate(k, blo));
     }
-    let idx = |name: &str| super::plan::strain_index(name).unwrap_or(0);
     // n samples over a share f of the spacing axis keep the base spacing when n − 1 ≥ f (N − 1)
     let count = |n: usize, f: f64, min: usize| {
         ((f * n.saturating_sub(1) as f64 - 1e-9).ceil().max(0.0) as usize + 1).clamp(min.min(n), n)
@@ -177,8 +176,8 @@ pub fn scene_plan(base: &Plan, extent: &StrainExtent, margin: f64) -> (Plan, Sce
                 .map(|(p, [a, b])| {
                     let [na, nb] = base.n_2d(p);
                     [
-                        count(na, fraction[idx(a)], 5),
-                        count(nb, fraction[idx(b)], 5),
+                        count(na, fraction[a.index()], 5),
+                        count(nb, fraction[b.index()], 5),
                     ]
                 })
                 .collect(),
@@ -250,8 +249,8 @@ mod tests {
             );
         }
         for (q, [a, b]) in p.pairs.iter().enumerate() {
-            for (side, name) in [a, b].into_iter().enumerate() {
-                let k = crate::sample::plan::strain_index(name).unwrap();
+            for (side, c) in [a, b].into_iter().enumerate() {
+                let k = c.index();
                 let n = p.n_2d(q)[side];
                 assert!(n == 5 || step(n, r.fraction[k]) <= step(base.count_2d, 1.0) + 1e-12);
             }

@@ -79,8 +79,8 @@ impl ElementModel {
             m.terms2d.clear();
         }
         if !bending {
-            m.terms1d.retain(|t| t.k <= 2);
-            m.terms2d.retain(|t| t.k1 <= 2);
+            m.terms1d.retain(|t| t.strain.is_in_plane());
+            m.terms2d.retain(|t| t.strains[1].is_in_plane());
         }
         ElementModel {
             material: m,

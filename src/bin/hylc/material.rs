@@ -2,7 +2,8 @@
 
 use anyhow::anyhow;
 use hylc::material::synthetic::default_material;
-use hylc::material::{Material, PsiVgh, STRAIN_NAMES};
+use hylc::material::{Material, PsiVgh};
+use hylc::strain::Strain6;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -33,7 +34,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mat = load_material(&a.file)?;
     let mut strains = Vec::new();
     for (i, s) in a.z.iter().enumerate() {
-        strains.push(parse_strain(s).map_err(|e| anyhow!("--z #{} {s:?}: {e}", i + 1))?);
+        strains.push(
+            s.parse::<Strain6>()
+                .map_err(|e| anyhow!("--z #{} {s:?}: {e}", i + 1))?
+                .0,
+        );
     }
     if let Some(path) = &a.z_file {
         let text = std::fs::read_to_string(path)
@@ -44,7 +49,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
                 continue;
             }
             strains.push(
-                parse_strain(line).map_err(|e| anyhow!("{}:{}: {e}", path.display(), n + 1))?,
+                line.parse::<Strain6>()
+                    .map_err(|e| anyhow!("{}:{}: {e}", path.display(), n + 1))?
+                    .0,
             );
         }
     }
@@ -73,31 +80,6 @@ fn load_material(file: &str) -> anyhow::Result<Material> {
     } else {
         Ok(Material::load(Path::new(file))?)
     }
-}
-
-/// Parse six numbers separated by commas and/or whitespace.
-fn parse_strain(text: &str) -> Result<[f64; 6], String> {
-    let parts: Vec<&str> = text
-        .split(|c: char| c == ',' || c.is_whitespace())
-        .filter(|s| !s.is_empty())
-        .collect();
-    if parts.len() != 6 {
-        return Err(format!(
-            "expected 6 numbers (s_x, s_a, s_y, II00, II01, II11), found {}",
-            parts.len()
-        ));
-    }
-    let mut z = [0.0; 6];
-    for (i, p) in parts.iter().enumerate() {
-        let v: f64 = p
-            .parse()
-            .map_err(|_| format!("{} = {p:?} is not a number", STRAIN_NAMES[i]))?;
-        if !v.is_finite() {
-            return Err(format!("{} = {p} is not finite", STRAIN_NAMES[i]));
-        }
-        z[i] = v;
-    }
-    Ok(z)
 }
 
 fn psi_json(z: &[f64; 6], r: &PsiVgh) -> String {

@@ -3,6 +3,7 @@
 
 use anyhow::anyhow;
 use hylc::sample::scene::{scene_plan, StrainExtent};
+use hylc::strain::StrainComponent;
 use hylc::workflow::inputs::load_plan;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -66,7 +67,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     for k in 0..5 {
         println!(
             "{:<8} [{:>9.4}, {:>9.4}]   [{:>9.4}, {:>9.4}]   {:>5.1} %",
-            hylc::micro::strain::STRAIN_NAMES[k],
+            StrainComponent::NAMES[k],
             r.visited[k][0],
             r.visited[k][1],
             r.ranges[k][0],

@@ -5,9 +5,9 @@ use crate::strain::{load_pattern_noted, parse_strain};
 use hylc::micro::envelope::{
     parameter_derivatives, strain_derivatives, strain_stiffness, PARAMETER_NAMES,
 };
-use hylc::micro::strain::STRAIN_NAMES;
 use hylc::micro::{MicroProblem, SolverOptions};
 use hylc::rod::YarnMaterial;
+use hylc::strain::StrainComponent;
 use std::process::ExitCode;
 
 /// Ψ̄ at one strain with its derivatives with respect to the strain and to the yarn parameters (envelope
@@ -30,7 +30,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let ds = strain_derivatives(&problem, &sol.state)?;
     let dp = parameter_derivatives(&problem, &sol)?;
     println!("Ψ̄ = {psi:.6e} J/m² ({} steps)", sol.steps);
-    for (n, v) in STRAIN_NAMES.iter().zip(ds) {
+    for (n, v) in StrainComponent::NAMES.iter().zip(ds) {
         match v {
             Some(v) => println!("  ∂Ψ̄/∂{n} = {v:.6e}"),
             None => println!("  ∂Ψ̄/∂{n}: not available (bending along the other axis)"),
@@ -40,7 +40,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         println!("  ∂Ψ̄/∂{n} = {v:.6e}");
     }
     let st = strain_stiffness(&problem, &sol.state)?;
-    let names: Vec<&str> = st.components.iter().map(|&k| STRAIN_NAMES[k]).collect();
+    let names: Vec<&str> = st
+        .components
+        .iter()
+        .map(|&k| StrainComponent::NAMES[k])
+        .collect();
     println!("  d²Ψ̄/dz² over ({}):", names.join(", "));
     for i in 0..names.len() {
         let row: Vec<String> = (0..names.len())

@@ -6,9 +6,9 @@ use crate::strain::{load_pattern_noted, parse_strain};
 use anyhow::anyhow;
 use hylc::micro::envelope::strain_derivatives;
 use hylc::micro::solver::world_positions;
-use hylc::micro::strain::STRAIN_NAMES;
 use hylc::micro::{MacroStrain, MicroProblem, Solution, SolverOptions};
 use hylc::rod::YarnMaterial;
+use hylc::strain::StrainComponent;
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -155,7 +155,7 @@ fn report(problem: &MicroProblem, sol: &Solution) -> serde_json::Value {
             "stretch": sol.energy.stretch, "bend": sol.energy.bend,
             "twist": sol.energy.twist, "contact": sol.energy.contact,
         },
-        "stress": stress.map(|s| STRAIN_NAMES.iter().zip(s).map(|(n, v)| (n.to_string(), json!(v))).collect::<serde_json::Map<_, _>>()),
+        "stress": stress.map(|s| StrainComponent::NAMES.iter().zip(s).map(|(n, v)| (n.to_string(), json!(v))).collect::<serde_json::Map<_, _>>()),
         "steps": sol.steps,
         "gradient_norm": sol.gradient_norm,
         "time": sol.time,
