@@ -3,16 +3,16 @@
 //! Pair kernel: a touching crossing pair (perpendicular segments of 2r, normalised gap ρ = 0.9, so the central
 //! quadrature pairs are inside the cut-off and the outer ones beyond), value alone and value + gradient + Hessian
 //! at Q = 2, 4, 8; num-dual AD of the reference at Q = 4 as a baseline. Broad phase: the synthetic weave of
-//! `hylc::contact::broad::synthetic_weave` with 6 + 6 yarns of 24 segments (288 segments, periods 24 r), build +
+//! `hylc::generate::synthetic_weave` with 6 + 6 yarns of 24 segments (288 segments, periods 24 r), build +
 //! query and refit + query with the 3 × 3 flat images, and the brute-force reference.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hylc::checks::contact::PairCheck;
-use hylc::contact::broad::synthetic_weave;
 use hylc::contact::{
     brute_force_candidates, tile_segments, BroadPhase, PairKernel, SegmentTopology,
 };
 use hylc::diff::reference_ad;
+use hylc::generate::synthetic_weave;
 use hylc::periodic::TileImages;
 use nalgebra::Vector3;
 use std::hint::black_box;

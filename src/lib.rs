@@ -10,7 +10,7 @@
 //! 4. homogenization: [`sample`], [`fit`];
 //! 5. cloth: [`shell`];
 //! 6. on top: [`generate`] (pattern generators), [`workflow`] (the stages put together as the command line runs
-//!    them, up to the main job), [`validate`] (conformance against the original data), [`checks`] (every energy
+//!    them, up to the main job), [`validation`] (verification against the original data: conformance, calibration, the micro grid), [`checks`] (every energy
 //!    registered with the harness).
 
 // 1. foundations
@@ -34,7 +34,7 @@ pub mod shell;
 // 6. on top
 pub mod checks;
 pub mod generate;
-pub mod validate;
+pub mod validation;
 pub mod workflow;
 
 use std::path::PathBuf;

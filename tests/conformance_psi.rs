@@ -1,12 +1,12 @@
 //! Conformance of ψ, ∇ψ, ∇²ψ with the original implementation on its five materials
-//! (`../shared/oracles/psi_oracle.json`; `06-verification.md`, 3a; `hylc::validate::psi_conformance`). Relative
+//! (`../shared/oracles/psi_oracle.json`; `06-verification.md`, 3a; `hylc::validation::conformance::psi_conformance`). Relative
 //! normwise tolerances of issue 2: 1e-10 for ψ and ∇ψ, 1e-8 for ∇²ψ. The oracle README warns of ~1e-6 round-off
 //! in one Hessian entry of the original near equal principal curvatures; normwise, every sample (those included)
 //! is held to 1e-8.
 
 mod common;
 
-use hylc::validate::psi_conformance;
+use hylc::validation::conformance::psi_conformance;
 
 #[test]
 fn psi_matches_the_original_on_all_five_materials() {

@@ -4,12 +4,12 @@
 
 mod common;
 
-use hylc::micro::grid::{
-    counterpart, run_grid, summarize, GridData, GridError, GridOptions, GRID_LEN,
-};
 use hylc::micro::{MacroStrain, MicroProblem, SolverOptions};
 use hylc::pattern::Pattern;
 use hylc::rod::YarnMaterial;
+use hylc::validation::grid::{
+    counterpart, run_grid, summarize, GridData, GridError, GridOptions, GRID_LEN,
+};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 fn original(shared: &std::path::Path, file: &str) -> Pattern {

@@ -116,13 +116,16 @@ fn run_writes_every_stage_and_resumes() {
         dt: 0.0125,
         ..RunConfig::default()
     };
-    let (mut lines, mut steps) = (Vec::new(), Vec::new());
+    let (mut lines, mut steps, mut samples) = (Vec::new(), Vec::new(), Vec::new());
     let summary = pipeline::run(&config, &mut |e| match e {
         Event::Log(l) => lines.push(l.to_string()),
         Event::Step { done, total, .. } => steps.push((done, total)),
+        Event::Samples { done, todo } => samples.push((done, todo)),
         Event::Print(_) | Event::Note(_) => {}
     })
     .unwrap();
+    // nothing left to sample: the plan and the held-out grid each report (0 of 0) once
+    assert_eq!(samples, vec![(0, 0), (0, 0)]);
     let log_after = std::fs::read_to_string(out.join("run.log")).unwrap();
     assert_eq!(
         log_after.strip_prefix(log_before.as_str()).unwrap(),

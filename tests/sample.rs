@@ -8,7 +8,9 @@ use common::cli_error;
 use hylc::generate::default_pattern;
 use hylc::micro::{MicroProblem, SolverOptions};
 use hylc::rod::YarnMaterial;
-use hylc::sample::{merge, read_samples, run_plan, Plan, Record, RunOptions, SampleStart};
+use hylc::sample::{
+    merge, read_samples, run_plan, run_plan_with, Plan, Record, RunOptions, SampleStart,
+};
 use hylc::strain::StrainComponent::{Sa, Sx, Sy, II00};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -112,7 +114,15 @@ fn resume_after_truncation_writes_the_same_records() {
         limit: Some(5),
         ..Default::default()
     };
-    assert_eq!(run_plan(&problem, &plan, &lim, &opts).unwrap().written, 5);
+    let calls = std::sync::Mutex::new(Vec::new());
+    let progress = |done: usize, todo: usize| calls.lock().unwrap().push((done, todo));
+    let s = run_plan_with(&problem, &plan, &lim, &opts, &progress).unwrap();
+    assert_eq!(s.written, 5);
+    // progress: (0, 5) before the first solve, then each written count 1..=5 once
+    let mut calls = calls.into_inner().unwrap();
+    assert_eq!(calls[0], (0, 5));
+    calls.sort();
+    assert_eq!(calls, (0..=5).map(|n| (n, 5)).collect::<Vec<_>>());
     assert_same(&full, &run(&problem, &plan, &lim, RunOptions::default()));
 
     // another problem (solver settings) must not append to this file
@@ -124,7 +134,9 @@ fn resume_after_truncation_writes_the_same_records() {
             ..Default::default()
         },
     );
-    let e = run_plan(&other, &plan, &cut, &RunOptions::default()).unwrap_err();
+    let e = run_plan(&other, &plan, &cut, &RunOptions::default())
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("another problem"), "{e}");
     std::fs::remove_dir_all(&d).ok();
 }

@@ -1,11 +1,11 @@
 //! Conformance of the strain chain z(q) with the original macro-scale code (`../shared/oracles/strain_oracle.json`,
-//! `06-verification.md` 3a; `hylc::validate::strain_conformance`): value, 6×18 Jacobian and 6×18×18 Hessian (each
+//! `06-verification.md` 3a; `hylc::validation::conformance::strain_conformance`): value, 6×18 Jacobian and 6×18×18 Hessian (each
 //! z_k's Hessian is the weighted Hessian with the unit weight e_k) within 1e-10 relative normwise, at the stored
 //! positions and translated 2 m from the origin.
 
 mod common;
 
-use hylc::validate::strain_conformance;
+use hylc::validation::conformance::strain_conformance;
 
 #[test]
 fn strain_chain_matches_the_original() {

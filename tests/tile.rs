@@ -6,11 +6,11 @@ mod common;
 use hylc::generate::{weave, WeaveParams};
 use hylc::pattern::Pattern;
 use hylc::rod::{RodState, YarnMaterial};
-use hylc::tile::calibration::{
+use hylc::tile::{Terms, Tile, Want};
+use hylc::validation::calibration::{
     equilibrium_periods, fit, gradient_parts, residual, shear_ratio_from_angles, ContactForm,
     Stiffness,
 };
-use hylc::tile::{Terms, Tile, Want};
 
 fn plain() -> Pattern {
     weave(&WeaveParams::plain()).unwrap()

@@ -7,7 +7,6 @@
 
 pub mod elimination;
 pub mod envelope;
-pub mod grid;
 pub mod linear;
 pub mod reference;
 pub mod solver;

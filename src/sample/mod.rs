@@ -8,6 +8,35 @@ pub mod scene;
 
 pub use plan::{sample_range, Chain, InPlaneGrid, Plan, PlanError, Sample, Step};
 pub use run::{
-    merge, parse_shard, read_samples, run_plan, Record, RunOptions, RunSummary, SampleStart,
-    SampleStatus,
+    merge, parse_shard, read_samples, run_plan, run_plan_with, Record, RunOptions, RunSummary,
+    SampleStart, SampleStatus,
 };
+
+use std::path::PathBuf;
+
+/// Errors of sampling: a bad plan or argument, a sample file or strain log that cannot be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum SampleError {
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+    /// A file operation failed.
+    #[error("{}: {action}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        action: &'static str,
+        source: std::io::Error,
+    },
+    /// A line of a file is not what it should be.
+    #[error("{}:{line}: {message}", path.display())]
+    Line {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
+    /// A file as a whole is not what it should be.
+    #[error("{}: {message}", path.display())]
+    File { path: PathBuf, message: String },
+    /// A shard that is not `k/n` with 0 ≤ k < n.
+    #[error("--shard: expected k/n with 0 ≤ k < n, got {0:?}")]
+    Shard(String),
+}

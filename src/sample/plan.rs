@@ -9,7 +9,6 @@
 
 use crate::strain::StrainComponent;
 use serde::{Deserialize, Serialize};
-use std::fmt;
 use std::path::Path;
 
 /// SAMPLERANGE(z, z_min, z_max, N) of the design: for the stretches s_x, s_y (`k` = 0, 2)
@@ -197,23 +196,22 @@ impl Default for Plan {
 }
 
 /// A bad plan: the file (if any), the field and what is wrong.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{}plan field {field}: {message}", file.as_ref().map_or(String::new(), |f| format!("{f}: ")))]
 pub struct PlanError {
     pub file: Option<String>,
     pub field: String,
     pub message: String,
 }
 
-impl fmt::Display for PlanError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if let Some(file) = &self.file {
-            write!(f, "{file}: ")?;
-        }
-        write!(f, "plan field {}: {}", self.field, self.message)
-    }
+/// Why a field of a plan file could not be read (before the field's name is attached).
+#[derive(Debug, thiserror::Error)]
+enum FieldError {
+    #[error("missing")]
+    Missing,
+    #[error(transparent)]
+    Invalid(#[from] serde_json::Error),
 }
-
-impl std::error::Error for PlanError {}
 
 /// One sample of a plan.
 #[derive(Clone, Debug, PartialEq)]
@@ -520,15 +518,15 @@ impl Plan {
         fn field<T: serde::de::DeserializeOwned>(
             obj: &serde_json::Map<String, serde_json::Value>,
             key: &str,
-        ) -> Result<T, String> {
-            let v = obj.get(key).ok_or_else(|| "missing".to_string())?;
-            serde_json::from_value(v.clone()).map_err(|e| e.to_string())
+        ) -> Result<T, FieldError> {
+            let v = obj.get(key).ok_or(FieldError::Missing)?;
+            Ok(serde_json::from_value(v.clone())?)
         }
         // an absent or null optional field is None
         fn optional<T: serde::de::DeserializeOwned>(
             obj: &serde_json::Map<String, serde_json::Value>,
             key: &str,
-        ) -> Result<Option<T>, String> {
+        ) -> Result<Option<T>, FieldError> {
             match obj.get(key) {
                 None | Some(serde_json::Value::Null) => Ok(None),
                 Some(_) => field(obj, key).map(Some),
@@ -552,7 +550,8 @@ impl Plan {
         }
         let mut r = [[0.0; 2]; 5];
         for (k, name) in StrainComponent::NAMES.iter().enumerate() {
-            r[k] = field(ranges_obj, name).map_err(|m| err(&format!("ranges.{name}"), m))?;
+            r[k] = field(ranges_obj, name)
+                .map_err(|m| err(&format!("ranges.{name}"), m.to_string()))?;
         }
         let plan = Plan {
             ranges: Ranges {
@@ -562,14 +561,14 @@ impl Plan {
                 ii00: r[3],
                 ii11: r[4],
             },
-            count_1d: field(obj, "count_1d").map_err(|m| err("count_1d", m))?,
-            count_2d: field(obj, "count_2d").map_err(|m| err("count_2d", m))?,
-            pairs: parse_pairs(field(obj, "pairs").map_err(|m| err("pairs", m))?)
+            count_1d: field(obj, "count_1d").map_err(|m| err("count_1d", m.to_string()))?,
+            count_2d: field(obj, "count_2d").map_err(|m| err("count_2d", m.to_string()))?,
+            pairs: parse_pairs(field(obj, "pairs").map_err(|m| err("pairs", m.to_string()))?)
                 .map_err(|(f, m)| err(&f, m))?,
-            ranges_2d: optional(obj, "ranges_2d").map_err(|m| err("ranges_2d", m))?,
-            grid: optional(obj, "grid").map_err(|m| err("grid", m))?,
-            counts_1d: optional(obj, "counts_1d").map_err(|m| err("counts_1d", m))?,
-            counts_2d: optional(obj, "counts_2d").map_err(|m| err("counts_2d", m))?,
+            ranges_2d: optional(obj, "ranges_2d").map_err(|m| err("ranges_2d", m.to_string()))?,
+            grid: optional(obj, "grid").map_err(|m| err("grid", m.to_string()))?,
+            counts_1d: optional(obj, "counts_1d").map_err(|m| err("counts_1d", m.to_string()))?,
+            counts_2d: optional(obj, "counts_2d").map_err(|m| err("counts_2d", m.to_string()))?,
         };
         plan.validate().map_err(|mut e| {
             e.file = file.map(str::to_string);

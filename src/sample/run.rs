@@ -15,10 +15,10 @@
 //! - Shards: shard k of n runs the chains with index ≡ k (mod n); [`merge`] concatenates shard files and removes
 //!   duplicate ids.
 
-use super::plan::{fnv1a64, Plan};
+use super::plan::{fnv1a64, Plan, Sample, Step};
+use super::SampleError;
 use crate::micro::envelope::strain_derivatives;
 use crate::micro::{MacroStrain, MicroProblem, MicroState, Status};
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
@@ -102,8 +102,6 @@ pub struct RunOptions {
     pub shard: Option<(usize, usize)>,
     /// Stop after writing this many samples.
     pub limit: Option<usize>,
-    /// Show a progress bar on stderr.
-    pub progress: bool,
 }
 
 /// What a run did.
@@ -136,8 +134,8 @@ pub fn problem_hash(problem: &MicroProblem) -> String {
 }
 
 /// Parse `k/n` (0 ≤ k < n).
-pub fn parse_shard(text: &str) -> Result<(usize, usize), String> {
-    let bad = || format!("--shard: expected k/n with 0 ≤ k < n, got {text:?}");
+pub fn parse_shard(text: &str) -> Result<(usize, usize), SampleError> {
+    let bad = || SampleError::Shard(text.to_string());
     let (k, n) = text.split_once('/').ok_or_else(bad)?;
     let k: usize = k.trim().parse().map_err(|_| bad())?;
     let n: usize = n.trim().parse().map_err(|_| bad())?;
@@ -149,47 +147,51 @@ pub fn parse_shard(text: &str) -> Result<(usize, usize), String> {
 
 /// Read a sample file: its records, in file order. A last line without its newline (an interrupted write) is
 /// ignored, and with `repair` cut off the file; any other unreadable line is an error naming file and line.
-pub fn read_samples(path: &Path, repair: bool) -> Result<Vec<Record>, String> {
-    let name = path.display();
+pub fn read_samples(path: &Path, repair: bool) -> Result<Vec<Record>, SampleError> {
+    let io = |action, source| SampleError::Io {
+        path: path.to_path_buf(),
+        action,
+        source,
+    };
     let text = match std::fs::read(path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(vec![]),
-        Err(e) => return Err(format!("{name}: cannot read: {e}")),
+        Err(e) => return Err(io("cannot read", e)),
     };
     let complete = text.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
     if complete < text.len() && repair {
         let f = OpenOptions::new()
             .write(true)
             .open(path)
-            .map_err(|e| format!("{name}: cannot open to cut off the truncated last line: {e}"))?;
+            .map_err(|e| io("cannot open to cut off the truncated last line", e))?;
         f.set_len(complete as u64)
             .and_then(|_| f.sync_data())
-            .map_err(|e| format!("{name}: cannot cut off the truncated last line: {e}"))?;
+            .map_err(|e| io("cannot cut off the truncated last line", e))?;
     }
-    let text = std::str::from_utf8(&text[..complete])
-        .map_err(|e| format!("{name}: not UTF-8 text: {e}"))?;
+    let text = std::str::from_utf8(&text[..complete]).map_err(|e| SampleError::File {
+        path: path.to_path_buf(),
+        message: format!("not UTF-8 text: {e}"),
+    })?;
     let mut out = Vec::new();
     for (i, line) in text.lines().enumerate() {
         if line.trim().is_empty() {
             continue;
         }
-        let r: Record = serde_json::from_str(line)
-            .map_err(|e| format!("{name}:{}: not a sample record: {e}", i + 1))?;
+        let r: Record = serde_json::from_str(line).map_err(|e| SampleError::Line {
+            path: path.to_path_buf(),
+            line: i + 1,
+            message: format!("not a sample record: {e}"),
+        })?;
         out.push(r);
     }
     Ok(out)
 }
 
-/// Append one record as a single write of the full line, then sync it to disk.
-fn append(file: &Mutex<File>, record: &Record) -> Result<(), String> {
-    let mut line = serde_json::to_string(record).map_err(|e| e.to_string())?;
-    line.push('\n');
-    let mut f = file
-        .lock()
-        .map_err(|_| "sample file lock poisoned".to_string())?;
-    f.write_all(line.as_bytes())
-        .and_then(|_| f.sync_data())
-        .map_err(|e| format!("cannot append to the sample file: {e}"))
+/// A record as one line of JSON (with its newline).
+fn record_line(record: &Record) -> String {
+    serde_json::to_string(record)
+        .expect("sample records serialise (string keys, no custom serialisers)")
+        + "\n"
 }
 
 /// Run `plan` on `problem`, appending to the sample file `out` (created if missing; finished ids skipped).
@@ -198,19 +200,32 @@ pub fn run_plan(
     plan: &Plan,
     out: &Path,
     opts: &RunOptions,
-) -> Result<RunSummary, String> {
+) -> Result<RunSummary, SampleError> {
+    run_plan_with(problem, plan, out, opts, &|_, _| {})
+}
+
+/// [`run_plan`], calling `progress(written, to_write)` once before the first solve and after every record written
+/// (from the worker threads).
+pub fn run_plan_with(
+    problem: &MicroProblem,
+    plan: &Plan,
+    out: &Path,
+    opts: &RunOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+) -> Result<RunSummary, SampleError> {
     let t0 = Instant::now();
-    plan.validate().map_err(|e| e.to_string())?;
+    plan.validate()?;
     let hash = problem_hash(problem);
     let existing = read_samples(out, true)?;
     if let Some(r) = existing.iter().find(|r| r.problem != hash) {
-        return Err(format!(
-            "{}: sample {} was solved for another problem (hash {}, this run {hash}): \
-             pattern, yarn parameters or solver settings differ",
-            out.display(),
-            r.id,
-            r.problem
-        ));
+        return Err(SampleError::File {
+            path: out.to_path_buf(),
+            message: format!(
+                "sample {} was solved for another problem (hash {}, this run {hash}): \
+                 pattern, yarn parameters or solver settings differ",
+                r.id, r.problem
+            ),
+        });
     }
     let done: HashSet<String> = existing.into_iter().map(|r| r.id).collect();
     let samples = plan.samples();
@@ -234,34 +249,74 @@ pub fn run_plan(
         .create(true)
         .append(true)
         .open(out)
-        .map_err(|e| format!("{}: cannot open for appending: {e}", out.display()))?;
-    let file = Mutex::new(file);
-    let bar = if opts.progress {
-        let b = ProgressBar::new(todo as u64);
-        if let Ok(style) = ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:40}] {pos}/{len} samples, {per_sec}, eta {eta}",
-        ) {
-            b.set_style(style);
-        }
-        b
-    } else {
-        ProgressBar::hidden()
+        .map_err(|e| SampleError::Io {
+            path: out.to_path_buf(),
+            action: "cannot open for appending",
+            source: e,
+        })?;
+    let run = PlanRun {
+        problem,
+        samples: &samples,
+        done: &done,
+        opts,
+        hash: &hash,
+        out,
+        file: Mutex::new(file),
+        todo,
+        progress,
+        written: AtomicUsize::new(0),
+        slots: AtomicUsize::new(0),
+        converged: AtomicUsize::new(0),
+        replayed: AtomicUsize::new(0),
+        stop: AtomicBool::new(false),
+        failure: Mutex::new(None),
     };
-    let written = AtomicUsize::new(0);
-    let slots = AtomicUsize::new(0);
-    let converged = AtomicUsize::new(0);
-    let replayed = AtomicUsize::new(0);
-    let stop = AtomicBool::new(false);
-    let failure: Mutex<Option<String>> = Mutex::new(None);
+    progress(0, todo);
+    chains.par_iter().for_each(|chain| run.chain(&chain.steps));
+    if let Some(e) = run.failure.into_inner().ok().flatten() {
+        return Err(e);
+    }
+    Ok(RunSummary {
+        selected,
+        already_done,
+        written: run.written.into_inner(),
+        converged: run.converged.into_inner(),
+        replayed: run.replayed.into_inner(),
+        time: t0.elapsed().as_secs_f64(),
+    })
+}
 
-    chains.par_iter().for_each(|chain| {
-        let steps = &chain.steps;
-        // which steps to solve: unfinished ones and (warm) every step they continue from
+/// The shared state of one [`run_plan_with`]: the inputs, the sample file and the counters the chains update.
+struct PlanRun<'a> {
+    problem: &'a MicroProblem,
+    samples: &'a [Sample],
+    /// Ids already in the sample file.
+    done: &'a HashSet<String>,
+    opts: &'a RunOptions,
+    hash: &'a str,
+    out: &'a Path,
+    file: Mutex<File>,
+    /// Records this run will write (at most).
+    todo: usize,
+    progress: &'a (dyn Fn(usize, usize) + Sync),
+    written: AtomicUsize,
+    /// Records claimed against `opts.limit`.
+    slots: AtomicUsize,
+    converged: AtomicUsize,
+    replayed: AtomicUsize,
+    stop: AtomicBool,
+    failure: Mutex<Option<SampleError>>,
+}
+
+impl PlanRun<'_> {
+    /// One chain, in order: its unfinished steps and (warm) every step they continue from, each started from the
+    /// nearest converged step up the chain.
+    fn chain(&self, steps: &[Step]) {
         let mut need: Vec<bool> = steps
             .iter()
-            .map(|s| !done.contains(&samples[s.sample].id))
+            .map(|s| !self.done.contains(&self.samples[s.sample].id))
             .collect();
-        if !opts.cold {
+        if !self.opts.cold {
             for i in (0..steps.len()).rev() {
                 if need[i] {
                     if let Some(f) = steps[i].from {
@@ -272,127 +327,143 @@ pub fn run_plan(
         }
         let mut states: Vec<Option<MicroState>> = vec![None; steps.len()];
         for (i, step) in steps.iter().enumerate() {
-            if !need[i] || stop.load(Ordering::Relaxed) {
+            if !need[i] || self.stop.load(Ordering::Relaxed) {
                 continue;
             }
-            let sample = &samples[step.sample];
-            let write = !done.contains(&sample.id);
+            let sample = &self.samples[step.sample];
+            let write = !self.done.contains(&sample.id);
             if write
-                && opts
+                && self
+                    .opts
                     .limit
-                    .is_some_and(|l| slots.fetch_add(1, Ordering::SeqCst) >= l)
+                    .is_some_and(|l| self.slots.fetch_add(1, Ordering::SeqCst) >= l)
             {
-                stop.store(true, Ordering::Relaxed);
+                self.stop.store(true, Ordering::Relaxed);
                 break;
             }
-            let strain = MacroStrain(sample.z);
-            // the nearest converged step up the chain, and its own converged predecessor
-            let mut a = if opts.cold { None } else { step.from };
-            while let Some(k) = a {
-                if states[k].is_some() {
-                    break;
-                }
-                a = steps[k].from;
-            }
-            let b = a
-                .and_then(|k| steps[k].from)
-                .filter(|&k| states[k].is_some());
-            let mut how = SampleStart::Cold;
-            let predicted = match (a, b) {
-                (Some(a), Some(b)) => match (&states[b], &states[a]) {
-                    (Some(sb), Some(sa)) => problem.predict(sb, sa, &strain).ok().flatten(),
-                    _ => None,
-                },
-                _ => None,
-            };
-            let start = if let Some(p) = predicted.as_ref() {
-                how = SampleStart::Predicted;
-                Some(p)
-            } else if let Some(s) = a.and_then(|a| states[a].as_ref()) {
-                how = SampleStart::Warm;
-                Some(s)
-            } else {
-                None
-            };
-            let t = Instant::now();
-            let result = problem.solve(&strain, start);
-            let record = match result {
-                Ok(sol) => {
-                    let ok = sol.status == Status::Converged;
-                    let stress = if ok {
-                        strain_derivatives(problem, &sol.state).ok()
-                    } else {
-                        None
-                    };
-                    let r = Record {
-                        id: sample.id.clone(),
-                        index: sample.index,
-                        z: sample.z,
-                        psi: sol.psi().ok(),
-                        stress,
-                        status: sol.status.into(),
-                        error: None,
-                        steps: sol.steps,
-                        gradient_norm: Some(sol.gradient_norm).filter(|g| g.is_finite()),
-                        time: sol.time,
-                        start: how,
-                        problem: hash.clone(),
-                    };
-                    if ok {
-                        states[i] = Some(sol.state);
-                    }
-                    r
-                }
-                Err(e) => Record {
-                    id: sample.id.clone(),
-                    index: sample.index,
-                    z: sample.z,
-                    psi: None,
-                    stress: None,
-                    status: SampleStatus::Error,
-                    error: Some(e.to_string()),
-                    steps: 0,
-                    gradient_norm: None,
-                    time: t.elapsed().as_secs_f64(),
-                    start: how,
-                    problem: hash.clone(),
-                },
-            };
+            let (record, state) = self.solve(steps, step, &states, sample);
+            states[i] = state;
             if write {
-                if let Err(e) = append(&file, &record) {
-                    if let Ok(mut f) = failure.lock() {
-                        f.get_or_insert(e);
-                    }
-                    stop.store(true, Ordering::Relaxed);
+                if !self.write(&record) {
                     break;
                 }
-                written.fetch_add(1, Ordering::Relaxed);
-                if record.psi.is_some() {
-                    converged.fetch_add(1, Ordering::Relaxed);
-                }
-                bar.inc(1);
             } else {
-                replayed.fetch_add(1, Ordering::Relaxed);
+                self.replayed.fetch_add(1, Ordering::Relaxed);
             }
         }
-    });
-    bar.finish_and_clear();
-    if let Some(e) = failure.into_inner().ok().flatten() {
-        return Err(format!("{}: {e}", out.display()));
     }
-    Ok(RunSummary {
-        selected,
-        already_done,
-        written: written.into_inner(),
-        converged: converged.into_inner(),
-        replayed: replayed.into_inner(),
-        time: t0.elapsed().as_secs_f64(),
-    })
+
+    /// Solve one step from its start (secant prediction, warm or cold); the record, and the state when converged.
+    fn solve(
+        &self,
+        steps: &[Step],
+        step: &Step,
+        states: &[Option<MicroState>],
+        sample: &Sample,
+    ) -> (Record, Option<MicroState>) {
+        let problem = self.problem;
+        let strain = MacroStrain(sample.z);
+        // the nearest converged step up the chain, and its own converged predecessor
+        let mut a = if self.opts.cold { None } else { step.from };
+        while let Some(k) = a {
+            if states[k].is_some() {
+                break;
+            }
+            a = steps[k].from;
+        }
+        let b = a
+            .and_then(|k| steps[k].from)
+            .filter(|&k| states[k].is_some());
+        let mut how = SampleStart::Cold;
+        let predicted = match (a, b) {
+            (Some(a), Some(b)) => match (&states[b], &states[a]) {
+                (Some(sb), Some(sa)) => problem.predict(sb, sa, &strain).ok().flatten(),
+                _ => None,
+            },
+            _ => None,
+        };
+        let start = if let Some(p) = predicted.as_ref() {
+            how = SampleStart::Predicted;
+            Some(p)
+        } else if let Some(s) = a.and_then(|a| states[a].as_ref()) {
+            how = SampleStart::Warm;
+            Some(s)
+        } else {
+            None
+        };
+        let t = Instant::now();
+        let mut record = Record {
+            id: sample.id.clone(),
+            index: sample.index,
+            z: sample.z,
+            psi: None,
+            stress: None,
+            status: SampleStatus::Error,
+            error: None,
+            steps: 0,
+            gradient_norm: None,
+            time: 0.0,
+            start: how,
+            problem: self.hash.to_string(),
+        };
+        match problem.solve(&strain, start) {
+            Ok(sol) => {
+                let ok = sol.status == Status::Converged;
+                if ok {
+                    record.stress = strain_derivatives(problem, &sol.state).ok();
+                }
+                record.psi = sol.psi().ok();
+                record.status = sol.status.into();
+                record.steps = sol.steps;
+                record.gradient_norm = Some(sol.gradient_norm).filter(|g| g.is_finite());
+                record.time = sol.time;
+                (record, ok.then_some(sol.state))
+            }
+            Err(e) => {
+                record.error = Some(e.to_string());
+                record.time = t.elapsed().as_secs_f64();
+                (record, None)
+            }
+        }
+    }
+
+    /// Append a record as a single write of the full line, then sync it to disk; count it and report progress.
+    /// False (and the run stops) when the file cannot be written.
+    fn write(&self, record: &Record) -> bool {
+        let line = record_line(record);
+        let result = match self.file.lock() {
+            Ok(mut f) => f
+                .write_all(line.as_bytes())
+                .and_then(|_| f.sync_data())
+                .map_err(|e| SampleError::Io {
+                    path: self.out.to_path_buf(),
+                    action: "cannot append to the sample file",
+                    source: e,
+                }),
+            Err(_) => Err(SampleError::File {
+                path: self.out.to_path_buf(),
+                message: "sample file lock poisoned".into(),
+            }),
+        };
+        if let Err(e) = result {
+            if let Ok(mut f) = self.failure.lock() {
+                f.get_or_insert(e);
+            }
+            self.stop.store(true, Ordering::Relaxed);
+            return false;
+        }
+        let n = self.written.fetch_add(1, Ordering::Relaxed) + 1;
+        if record.psi.is_some() {
+            self.converged.fetch_add(1, Ordering::Relaxed);
+        }
+        (self.progress)(n, self.todo);
+        true
+    }
 }
 
 /// Merge sample files (e.g. shards) into `out`: all records, the first of each id kept, ordered by plan index then
 /// id. Returns (records written, duplicates dropped). `out` is written to a temporary file and renamed.
-pub fn merge(out: &Path, inputs: &[&Path]) -> Result<(usize, usize), String> {
+pub fn merge(out: &Path, inputs: &[&Path]) -> Result<(usize, usize), SampleError> {
     let mut seen = HashSet::new();
     let mut records = Vec::new();
     let mut duplicates = 0;
@@ -406,15 +477,15 @@ pub fn merge(out: &Path, inputs: &[&Path]) -> Result<(usize, usize), String> {
         }
     }
     records.sort_by(|a, b| a.index.cmp(&b.index).then_with(|| a.id.cmp(&b.id)));
-    let mut text = String::new();
-    for r in &records {
-        text.push_str(&serde_json::to_string(r).map_err(|e| e.to_string())?);
-        text.push('\n');
-    }
+    let text: String = records.iter().map(record_line).collect();
     let tmp = out.with_extension("merge-tmp");
     std::fs::write(&tmp, text)
         .and_then(|_| std::fs::rename(&tmp, out))
-        .map_err(|e| format!("{}: cannot write: {e}", out.display()))?;
+        .map_err(|e| SampleError::Io {
+            path: out.to_path_buf(),
+            action: "cannot write",
+            source: e,
+        })?;
     Ok((records.len(), duplicates))
 }
 
@@ -424,10 +495,14 @@ mod tests {
 
     #[test]
     fn shard_parsing() {
-        assert_eq!(parse_shard("0/2"), Ok((0, 2)));
-        assert_eq!(parse_shard(" 3 / 4 "), Ok((3, 4)));
+        assert_eq!(parse_shard("0/2").unwrap(), (0, 2));
+        assert_eq!(parse_shard(" 3 / 4 ").unwrap(), (3, 4));
         for bad in ["2/2", "1", "a/b", "0/0", "-1/2"] {
-            assert!(parse_shard(bad).is_err(), "{bad}");
+            let e = parse_shard(bad).unwrap_err().to_string();
+            assert_eq!(
+                e,
+                format!("--shard: expected k/n with 0 ≤ k < n, got {bad:?}")
+            );
         }
     }
 
@@ -477,8 +552,8 @@ mod tests {
         assert_eq!(read_samples(&path, true).unwrap(), vec![r.clone()]);
         assert_eq!(std::fs::read_to_string(&path).unwrap(), format!("{line}\n"));
         std::fs::write(&path, format!("{}\n{line}\n", &line[..20])).unwrap();
-        let e = read_samples(&path, false).unwrap_err();
-        assert!(e.contains("s.jsonl:1"), "{e}");
+        let e = read_samples(&path, false).unwrap_err().to_string();
+        assert!(e.contains("s.jsonl:1: not a sample record"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -8,6 +8,7 @@
 //! ranges get the symmetric interval of that bound.
 
 use super::plan::{Plan, Ranges};
+use super::SampleError;
 use std::path::Path;
 
 /// The extremes of each macro strain component over a run (min, max per component of z).
@@ -55,46 +56,48 @@ impl StrainExtent {
     /// Read the extremes of every line of a `hylc simulate` log (`log.jsonl`): `strain_min`/`strain_max`
     /// (`outliers` true: every triangle) or the 1st/99th percentiles `strain_p01`/`strain_p99` (false: what 98 % of
     /// the triangles visit in each step, without the few of a mesh-scale crease); errors name the file and line.
-    pub fn read_log(path: &Path, into: &mut StrainExtent, outliers: bool) -> Result<(), String> {
+    pub fn read_log(
+        path: &Path,
+        into: &mut StrainExtent,
+        outliers: bool,
+    ) -> Result<(), SampleError> {
         let (kmin, kmax) = if outliers {
             ("strain_min", "strain_max")
         } else {
             ("strain_p01", "strain_p99")
         };
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        let text = std::fs::read_to_string(path).map_err(|e| SampleError::Io {
+            path: path.to_path_buf(),
+            action: "cannot read",
+            source: e,
+        })?;
         let mut n = 0;
         for (i, line) in text.lines().enumerate() {
             if line.trim().is_empty() {
                 continue;
             }
-            let v: serde_json::Value = serde_json::from_str(line)
-                .map_err(|e| format!("{}:{}: not JSON: {e}", path.display(), i + 1))?;
-            let get = |key: &str| -> Result<[f64; 6], String> {
+            let bad = |message: String| SampleError::Line {
+                path: path.to_path_buf(),
+                line: i + 1,
+                message,
+            };
+            let v: serde_json::Value =
+                serde_json::from_str(line).map_err(|e| bad(format!("not JSON: {e}")))?;
+            let get = |key: &str| -> Result<[f64; 6], SampleError> {
                 let a = v.get(key).and_then(|a| a.as_array()).ok_or_else(|| {
-                    format!(
-                        "{}:{}: no `{key}` array (is this a `hylc simulate` log.jsonl?)",
-                        path.display(),
-                        i + 1
-                    )
+                    bad(format!(
+                        "no `{key}` array (is this a `hylc simulate` log.jsonl?)"
+                    ))
                 })?;
                 let mut out = [0.0; 6];
                 if a.len() != 6 {
-                    return Err(format!(
-                        "{}:{}: `{key}` has {} entries, expected 6",
-                        path.display(),
-                        i + 1,
-                        a.len()
-                    ));
+                    return Err(bad(format!("`{key}` has {} entries, expected 6", a.len())));
                 }
                 for (o, x) in out.iter_mut().zip(a) {
-                    *o = x.as_f64().filter(|x| x.is_finite()).ok_or_else(|| {
-                        format!(
-                            "{}:{}: `{key}`: {x} is not a finite number",
-                            path.display(),
-                            i + 1
-                        )
-                    })?;
+                    *o = x
+                        .as_f64()
+                        .filter(|x| x.is_finite())
+                        .ok_or_else(|| bad(format!("`{key}`: {x} is not a finite number")))?;
                 }
                 Ok(out)
             };
@@ -102,7 +105,10 @@ impl StrainExtent {
             n += 1;
         }
         if n == 0 {
-            return Err(format!("{}: no steps", path.display()));
+            return Err(SampleError::File {
+                path: path.to_path_buf(),
+                message: "no steps".into(),
+            });
         }
         Ok(())
     }
@@ -269,14 +275,18 @@ mod tests {
             "{\"strain_min\":[0,0,0,0,0,0],\"strain_max\":[0,0,0,0,0,0]}\n{\"step\":2}\n",
         )
         .unwrap();
-        let e = StrainExtent::read_log(&f, &mut StrainExtent::empty(), true).unwrap_err();
+        let e = StrainExtent::read_log(&f, &mut StrainExtent::empty(), true)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("log.jsonl:2: no `strain_min`"), "{e}");
         std::fs::write(
             &f,
             "{\"strain_min\":[0,0,0,0,0],\"strain_max\":[0,0,0,0,0,0]}\n",
         )
         .unwrap();
-        let e = StrainExtent::read_log(&f, &mut StrainExtent::empty(), true).unwrap_err();
+        let e = StrainExtent::read_log(&f, &mut StrainExtent::empty(), true)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains(":1: `strain_min` has 5 entries"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }

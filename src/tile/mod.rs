@@ -7,7 +7,6 @@
 //! Reference frames come from a stored [`RodState`] and are parallel-transported to the evaluated positions, so the
 //! value, gradient and Hessian are those of one smooth function of the dofs (what the derivative harness checks).
 
-pub mod calibration;
 pub mod contact;
 
 pub use contact::ContactPair;

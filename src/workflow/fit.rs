@@ -118,7 +118,7 @@ fn find_density(
 /// table and the written files are reported as [`Event::Print`] lines.
 pub fn fit_samples(
     job: &FitJob,
-    on_event: &mut dyn FnMut(Event),
+    on_event: &mut (dyn FnMut(Event) + Send),
 ) -> Result<FitReport, WorkflowError> {
     let t0 = Instant::now();
     let samples = job.samples.as_path();
@@ -144,8 +144,13 @@ pub fn fit_samples(
             }
         }
     }
-    let mut fit = fit_material(&plan, &records, density, material_meta, &job.options)
-        .map_err(|e| WorkflowError::Stage(format!("{}: {e}", samples.display())))?;
+    let mut fit =
+        fit_material(&plan, &records, density, material_meta, &job.options).map_err(|source| {
+            WorkflowError::Fit {
+                samples: samples.to_path_buf(),
+                source,
+            }
+        })?;
     for h in &job.holdout {
         let mut hr = read_samples(h, false)?;
         // a file from a plan with an in-plane grid contributes its grid samples only

@@ -8,7 +8,8 @@
 //! - [`simulate`]: a cloth scene (C8) with overrides, its frames, log and PNG snapshot;
 //! - [`pipeline`]: the main job `hylc run` (C1 → C4 → C5–C7 → C8) end to end.
 //!
-//! Nothing here prints: what a terminal would show goes to an [`Event`] callback.
+//! Nothing here prints: what a terminal would show goes to an [`Event`] callback (`Send`, because sampling reports
+//! its progress from the worker threads).
 
 pub mod fit;
 pub mod inputs;
@@ -27,6 +28,8 @@ pub enum Event<'a> {
     Print(&'a str),
     /// A note or warning (the binary writes it to stderr).
     Note(&'a str),
+    /// A sample was written: `done` of the `todo` samples this sampling run writes.
+    Samples { done: usize, todo: usize },
     /// A cloth time step finished: `done` of `total` steps, simulated time, Newton iterations, final residual.
     Step {
         done: usize,
@@ -57,7 +60,21 @@ pub enum WorkflowError {
     Material(#[from] crate::material::json::MaterialError),
     #[error(transparent)]
     Shell(#[from] crate::shell::ShellError),
-    /// A stage that reports its errors as text (sampling, plots).
+    #[error(transparent)]
+    Sample(#[from] crate::sample::SampleError),
+    /// The reference state (C1) of a pattern failed.
+    #[error("{pattern}: reference state: {source}")]
+    Reference {
+        pattern: String,
+        source: crate::micro::reference::ReferenceError,
+    },
+    /// The fit (C5) of a sample file failed.
+    #[error("{}: {source}", samples.display())]
+    Fit {
+        samples: PathBuf,
+        source: crate::fit::FitError,
+    },
+    /// A stage that reports its errors as text (the PNG snapshot).
     #[error("{0}")]
     Stage(String),
     /// Bad input to a workflow, with the argument or file at fault.

@@ -9,7 +9,7 @@
 use super::fit::{fit_samples, FitJob};
 use super::inputs::{construction_of, load_pattern, load_plan};
 use super::sidecar::write_meta;
-use super::simulate::{execute, prepare, snapshot, summary_line, Overrides};
+use super::simulate::{execute, prepare, snapshot, summary_line, Outcome, Overrides};
 use super::{write_file, Event, WorkflowError};
 use crate::fit::model::FitReport;
 use crate::micro::reference::{reference_state, Construction, ReferenceOptions};
@@ -17,10 +17,11 @@ use crate::micro::{MicroProblem, SolverOptions};
 use crate::pattern::Pattern;
 use crate::rod::YarnMaterial;
 use crate::sample::plan::{fnv1a64, InPlaneGrid};
-use crate::sample::{run_plan, Plan, RunOptions};
+use crate::sample::{run_plan_with, Plan, RunOptions, RunSummary};
 use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::time::Instant;
 
 /// Settings of the main job (`hylc run`).
@@ -44,8 +45,6 @@ pub struct RunConfig {
     pub fresh: bool,
     /// The construction of `.pyp` patterns (generated kinds know theirs).
     pub construction: Option<Construction>,
-    /// Show the sampler's own progress bar on stderr.
-    pub sample_progress: bool,
 }
 
 impl Default for RunConfig {
@@ -62,7 +61,6 @@ impl Default for RunConfig {
             dt: 1.0 / 240.0,
             fresh: false,
             construction: None,
-            sample_progress: false,
         }
     }
 }
@@ -86,7 +84,7 @@ pub fn run_holdout_plan() -> Plan {
 struct Log<'a> {
     file: std::fs::File,
     path: PathBuf,
-    on_event: &'a mut dyn FnMut(Event),
+    on_event: &'a mut (dyn FnMut(Event) + Send),
 }
 
 impl Log<'_> {
@@ -98,6 +96,23 @@ impl Log<'_> {
     /// An event that is not part of the log.
     fn event(&mut self, e: Event) {
         (self.on_event)(e)
+    }
+
+    /// Run `plan` with its progress reported as [`Event::Samples`] (from the worker threads).
+    fn sample(
+        &mut self,
+        problem: &MicroProblem,
+        plan: &Plan,
+        out: &Path,
+        opts: &RunOptions,
+    ) -> Result<RunSummary, WorkflowError> {
+        let on_event = Mutex::new(&mut *self.on_event);
+        let progress = |done, todo| {
+            if let Ok(mut f) = on_event.lock() {
+                f(Event::Samples { done, todo })
+            }
+        };
+        Ok(run_plan_with(problem, plan, out, opts, &progress)?)
     }
 }
 
@@ -112,7 +127,7 @@ struct PatternRun {
 /// that it also writes to `summary.json` (drape steps that ended at the Newton cap are reported, not failed).
 pub fn run(
     args: &RunConfig,
-    on_event: &mut dyn FnMut(Event),
+    on_event: &mut (dyn FnMut(Event) + Send),
 ) -> Result<serde_json::Value, WorkflowError> {
     let t0 = Instant::now();
     if args.fresh && args.out.exists() {
@@ -223,16 +238,55 @@ fn folder_name(arg: &str) -> String {
         .map_or_else(|| arg.to_string(), |s| s.to_string_lossy().to_string())
 }
 
+/// One pattern through every stage, in the folder `args.out/<name>`.
 fn run_pattern(args: &RunConfig, arg: &str, log: &mut Log) -> Result<PatternRun, WorkflowError> {
     let name = folder_name(arg);
     let dir = args.out.join(&name);
     std::fs::create_dir_all(&dir).map_err(|e| WorkflowError::io(&dir, "cannot create", e))?;
-    let s = |f: &str| dir.join(f).display().to_string();
     let mut stages = Vec::new();
     log.line(&format!("\n== {name}"))?;
 
-    // 1. the pattern
     let t = Instant::now();
+    let (pattern, pattern_hash) = stage_pattern(arg, &dir, log)?;
+    stages.push(("generate", t.elapsed().as_secs_f64()));
+
+    let t = Instant::now();
+    let construction = construction_of(arg, args.construction)?;
+    let reference = stage_reference(&name, &dir, &pattern, &pattern_hash, construction, log)?;
+    stages.push(("reference", t.elapsed().as_secs_f64()));
+
+    let t = Instant::now();
+    let sampled = stage_sample(args, &dir, log)?;
+    stages.push(("sample", t.elapsed().as_secs_f64()));
+
+    // 4. fitting (C5–C7)
+    let t = Instant::now();
+    let job = FitJob {
+        out: dir.join("material.json"),
+        report: dir.join("fit.json"),
+        plots: dir.join("plots"),
+        holdout: vec![dir.join("holdout.jsonl")],
+        ..FitJob::beside(&dir.join("samples.jsonl"))
+    };
+    let report: FitReport = fit_samples(&job, &mut |e| log.event(e))?;
+    stages.push(("fit", t.elapsed().as_secs_f64()));
+
+    let t = Instant::now();
+    let (drape, line) = stage_drape(args, &dir, &job.out, log)?;
+    stages.push(("simulate", t.elapsed().as_secs_f64()));
+
+    let summary = pattern_summary(
+        args, arg, &dir, &reference, &stages, &sampled, &report, &drape, line,
+    );
+    Ok(PatternRun {
+        name,
+        stages,
+        summary,
+    })
+}
+
+/// Stage 1, the pattern, written to `pattern.pyp`; with the hash of its `.pyp` text.
+fn stage_pattern(arg: &str, dir: &Path, log: &mut Log) -> Result<(Pattern, String), WorkflowError> {
     let loaded = load_pattern(arg)?;
     if let Some(note) = loaded.note(arg) {
         log.event(Event::Note(&note));
@@ -249,58 +303,74 @@ fn run_pattern(args: &RunConfig, arg: &str, log: &mut Log) -> Result<PatternRun,
         pattern.periods[1],
         pattern_path.display()
     ))?;
-    stages.push(("generate", t.elapsed().as_secs_f64()));
+    Ok((pattern, pattern_hash))
+}
 
-    // 2. the reference state (C1), reused when the pattern is unchanged
-    let t = Instant::now();
-    let construction = construction_of(arg, args.construction)?;
+/// Stage 2, the reference state (C1) in `reference.pyp`, reused when the pattern is unchanged; returns the
+/// contents of `reference.json` (pattern hash, construction, report).
+fn stage_reference(
+    name: &str,
+    dir: &Path,
+    pattern: &Pattern,
+    pattern_hash: &str,
+    construction: Construction,
+    log: &mut Log,
+) -> Result<serde_json::Value, WorkflowError> {
     let ref_path = dir.join("reference.pyp");
     let ref_json = dir.join("reference.json");
     let reused = std::fs::read_to_string(&ref_json)
         .ok()
         .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-        .filter(|v| v["pattern hash"] == pattern_hash.as_str() && ref_path.exists());
-    let reference = match reused {
-        Some(v) => {
-            log.line(&format!(
-                "reference: reused {} (pattern unchanged)",
-                ref_path.display()
-            ))?;
-            v
-        }
-        None => {
-            let (q, report) = reference_state(
-                &pattern,
-                &YarnMaterial::default(),
-                construction,
-                &SolverOptions::default(),
-                &ReferenceOptions::default(),
-            )
-            .map_err(|e| WorkflowError::Stage(format!("{name}: reference state: {e}")))?;
-            q.save_pyp(&ref_path)?;
-            let v = json!({"pattern hash": pattern_hash, "construction": format!("{construction:?}"),
-                           "report": report});
-            write_file(
-                &ref_json,
-                serde_json::to_string_pretty(&v).expect("JSON values serialise") + "\n",
-            )?;
-            log.line(&format!(
-                "reference ({construction:?}): periods {:.4e} × {:.4e} m (strain {:+.2} %, {:+.2} %), \
-                 Ψ̄(0) = {:.4e} J/m², wrote {}",
-                report.periods_out[0],
-                report.periods_out[1],
-                100.0 * report.period_strain[0],
-                100.0 * report.period_strain[1],
-                report.psi,
-                ref_path.display()
-            ))?;
-            v
-        }
-    };
-    stages.push(("reference", t.elapsed().as_secs_f64()));
+        .filter(|v| v["pattern hash"] == pattern_hash && ref_path.exists());
+    if let Some(v) = reused {
+        log.line(&format!(
+            "reference: reused {} (pattern unchanged)",
+            ref_path.display()
+        ))?;
+        return Ok(v);
+    }
+    let (q, report) = reference_state(
+        pattern,
+        &YarnMaterial::default(),
+        construction,
+        &SolverOptions::default(),
+        &ReferenceOptions::default(),
+    )
+    .map_err(|source| WorkflowError::Reference {
+        pattern: name.to_string(),
+        source,
+    })?;
+    q.save_pyp(&ref_path)?;
+    let v = json!({"pattern hash": pattern_hash, "construction": format!("{construction:?}"),
+                   "report": report});
+    write_file(
+        &ref_json,
+        serde_json::to_string_pretty(&v).expect("JSON values serialise") + "\n",
+    )?;
+    log.line(&format!(
+        "reference ({construction:?}): periods {:.4e} × {:.4e} m (strain {:+.2} %, {:+.2} %), \
+         Ψ̄(0) = {:.4e} J/m², wrote {}",
+        report.periods_out[0],
+        report.periods_out[1],
+        100.0 * report.period_strain[0],
+        100.0 * report.period_strain[1],
+        report.psi,
+        ref_path.display()
+    ))?;
+    Ok(v)
+}
 
-    // 3. sampling (C4): the plan and the held-out grid, resumable
+/// What the sampling stage did: the plan, its run and the held-out grid's run.
+struct Sampled {
+    plan: Plan,
+    plan_run: RunSummary,
+    holdout_run: RunSummary,
+}
+
+/// Stage 3, sampling (C4): the plan into `samples.jsonl` and the held-out grid into `holdout.jsonl`, resumable.
+fn stage_sample(args: &RunConfig, dir: &Path, log: &mut Log) -> Result<Sampled, WorkflowError> {
     let t = Instant::now();
+    let ref_path = dir.join("reference.pyp");
     let (q, _) = Pattern::load_pyp(&ref_path)?;
     let problem = MicroProblem::new(q, &YarnMaterial::default(), SolverOptions::default());
     let plan = load_plan(&args.plan)?;
@@ -311,13 +381,12 @@ fn run_pattern(args: &RunConfig, arg: &str, log: &mut Log) -> Result<PatternRun,
         cold: false,
         shard: None,
         limit: None,
-        progress: args.sample_progress,
     };
-    let sp = run_plan(&problem, &plan, &samples, &opts)?;
+    let sp = log.sample(&problem, &plan, &samples, &opts)?;
     let holdout = dir.join("holdout.jsonl");
     let hplan = run_holdout_plan();
     write_meta(&holdout, &ref_arg, &hplan, &problem)?;
-    let sh = run_plan(&problem, &hplan, &holdout, &opts)?;
+    let sh = log.sample(&problem, &hplan, &holdout, &opts)?;
     log.line(&format!(
         "samples: plan {:016x}: {} samples ({} from an earlier run, {} solved, {} of them converged); held-out \
          grid: {} ({} solved, {} converged); {:.1} s; wrote {} and {}",
@@ -333,24 +402,20 @@ fn run_pattern(args: &RunConfig, arg: &str, log: &mut Log) -> Result<PatternRun,
         samples.display(),
         holdout.display()
     ))?;
-    stages.push(("sample", t.elapsed().as_secs_f64()));
+    Ok(Sampled {
+        plan,
+        plan_run: sp,
+        holdout_run: sh,
+    })
+}
 
-    // 4. fitting (C5–C7)
-    let t = Instant::now();
-    let material = dir.join("material.json");
-    let job = FitJob {
-        out: material.clone(),
-        report: dir.join("fit.json"),
-        plots: dir.join("plots"),
-        holdout: vec![holdout.clone()],
-        ..FitJob::beside(&samples)
-    };
-    let report: FitReport = fit_samples(&job, &mut |e| log.event(e))?;
-    stages.push(("fit", t.elapsed().as_secs_f64()));
-    let h = report.holdout.as_ref();
-
-    // 5. the drape (C8)
-    let t = Instant::now();
+/// Stage 5, the drape (C8) with the fitted `material`: frames in `simulate/`, `snapshot.png`; with its summary line.
+fn stage_drape(
+    args: &RunConfig,
+    dir: &Path,
+    material: &Path,
+    log: &mut Log,
+) -> Result<(Outcome, String), WorkflowError> {
     let ov = Overrides {
         material: Some(material.display().to_string()),
         duration: args.duration,
@@ -369,15 +434,32 @@ fn run_pattern(args: &RunConfig, arg: &str, log: &mut Log) -> Result<PatternRun,
     snapshot(&png, &scene, &o)?;
     let line = summary_line(&o.summary);
     log.line(&format!("simulate {}: {line}", args.scene))?;
-    stages.push(("simulate", t.elapsed().as_secs_f64()));
+    Ok((o, line))
+}
 
+/// One pattern's entry of `summary.json`.
+#[allow(clippy::too_many_arguments)]
+fn pattern_summary(
+    args: &RunConfig,
+    arg: &str,
+    dir: &Path,
+    reference: &serde_json::Value,
+    stages: &[(&str, f64)],
+    sampled: &Sampled,
+    report: &FitReport,
+    o: &Outcome,
+    line: String,
+) -> serde_json::Value {
+    let s = |f: &str| dir.join(f).display().to_string();
+    let (sp, sh) = (&sampled.plan_run, &sampled.holdout_run);
+    let h = report.holdout.as_ref();
     let last = o.summary.last.as_ref();
-    let summary = json!({
+    json!({
         "pattern": arg,
         "construction": reference["construction"],
         "reference": reference["report"],
         "stages": stages.iter().map(|(k, v)| (k.to_string(), json!(v))).collect::<serde_json::Map<_, _>>(),
-        "samples": {"plan": format!("{:016x}", plan.hash()), "selected": sp.selected,
+        "samples": {"plan": format!("{:016x}", sampled.plan.hash()), "selected": sp.selected,
                     "already_done": sp.already_done, "written": sp.written, "converged": sp.converged,
                     "holdout": sh.selected},
         "fit": {"samples": report.samples, "converged": report.converged,
@@ -393,10 +475,5 @@ fn run_pattern(args: &RunConfig, arg: &str, log: &mut Log) -> Result<PatternRun,
         "outputs": {"pattern": s("pattern.pyp"), "reference": s("reference.pyp"), "samples": s("samples.jsonl"),
                     "material": s("material.json"), "fit report": s("fit.json"), "plots": s("plots"),
                     "frames": s("simulate"), "snapshot": s("snapshot.png")},
-    });
-    Ok(PatternRun {
-        name,
-        stages,
-        summary,
     })
 }

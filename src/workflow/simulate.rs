@@ -82,7 +82,7 @@ pub fn execute(
     scene_arg: &str,
     dir: &Path,
     out: &Path,
-    on_event: &mut dyn FnMut(Event),
+    on_event: &mut (dyn FnMut(Event) + Send),
 ) -> Result<Outcome, WorkflowError> {
     let (mut sim, tris) = scene.build(scene_arg, dir)?;
     let steps = scene.steps();

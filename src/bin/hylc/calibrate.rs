@@ -1,11 +1,11 @@
 //! `hylc calibrate`: the yarn-parameter calibration against the original reference patterns
-//! (`06-verification.md` item b; `hylc::tile::calibration`).
+//! (`06-verification.md` item b; `hylc::validation::calibration`).
 
 use crate::args::parse_list;
 use anyhow::anyhow;
 use hylc::pattern::Pattern;
 use hylc::rod::YarnMaterial;
-use hylc::tile::calibration::{
+use hylc::validation::calibration::{
     calibrate, equilibrium_periods, Calibration, ContactForm, Stiffness,
 };
 use std::path::PathBuf;

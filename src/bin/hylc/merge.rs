@@ -21,7 +21,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         anyhow::bail!("merge: no input files");
     }
     let ins: Vec<&Path> = inputs.iter().map(|p| p.as_path()).collect();
-    let (n, dup) = merge(out, &ins).map_err(anyhow::Error::msg)?;
+    let (n, dup) = merge(out, &ins)?;
     // the first input's sidecar goes with the merged file (shards of one plan and problem share it)
     if let Some(src) = inputs.iter().map(|p| meta_path(p)).find(|p| p.exists()) {
         std::fs::copy(&src, meta_path(out))

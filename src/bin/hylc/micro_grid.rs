@@ -1,12 +1,12 @@
 //! `hylc micro-grid`: our micro solver against the original solver's displacements on the 9×9×9 in-plane grid
-//! (`../shared/design/06-verification.md`, item 3c; `hylc::micro::grid`).
+//! (`../shared/design/06-verification.md`, item 3c; `hylc::validation::grid`).
 
 use crate::args::{exit, SolverArgs};
 use crate::strain::load_pattern_noted;
 use anyhow::anyhow;
-use hylc::micro::grid::{run_grid, summarize, GridData, GridOptions, GridSummary, GRID_LEN};
 use hylc::micro::{MicroProblem, SolverOptions};
 use hylc::rod::YarnMaterial;
+use hylc::validation::grid::{run_grid, summarize, GridData, GridOptions, GridSummary, GRID_LEN};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

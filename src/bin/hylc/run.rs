@@ -53,7 +53,6 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         dt: a.dt,
         fresh: a.fresh,
         construction: a.construction.map(Into::into),
-        sample_progress: true,
     };
     let mut printer = Printer::default();
     pipeline::run(&config, &mut |e| printer.show(e))?;

@@ -2,14 +2,16 @@
 //! (`04-sampling-fitting.md`, section "Sampling plan (C4)"; `hylc::sample`).
 
 use crate::args::{exit, SolverArgs};
+use crate::printer::sample_bar;
 use crate::strain::load_pattern_noted;
 use hylc::micro::MicroProblem;
 use hylc::rod::YarnMaterial;
-use hylc::sample::{parse_shard, run_plan, RunOptions};
+use hylc::sample::{parse_shard, run_plan_with, RunOptions};
 use hylc::workflow::inputs::load_plan;
 use hylc::workflow::sidecar::write_meta;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::OnceLock;
 
 /// Run a sampling plan on a pattern (warm-started chains in parallel), appending to a JSON-lines sample file;
 /// finished samples are skipped, so an interrupted run resumes where it stopped.
@@ -40,27 +42,20 @@ pub struct Args {
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let (pattern, out, cold, limit) = (a.pattern.as_str(), a.out.as_path(), a.cold, a.limit);
     let plan = load_plan(&a.plan)?;
-    let shard = a
-        .shard
-        .as_deref()
-        .map(parse_shard)
-        .transpose()
-        .map_err(anyhow::Error::msg)?;
+    let shard = a.shard.as_deref().map(parse_shard).transpose()?;
     let p = load_pattern_noted(pattern)?;
     let problem = MicroProblem::new(p, &YarnMaterial::default(), a.solver.options());
     write_meta(out, pattern, &plan, &problem)?;
-    let s = run_plan(
-        &problem,
-        &plan,
-        out,
-        &RunOptions {
-            cold,
-            shard,
-            limit,
-            progress: true,
-        },
-    )
-    .map_err(anyhow::Error::msg)?;
+    let opts = RunOptions { cold, shard, limit };
+    let bar = OnceLock::new();
+    let progress = |done: usize, todo: usize| {
+        bar.get_or_init(|| sample_bar(todo))
+            .set_position(done as u64);
+    };
+    let s = run_plan_with(&problem, &plan, out, &opts, &progress)?;
+    if let Some(b) = bar.get() {
+        b.finish_and_clear();
+    }
     println!(
         "{}: plan {:016x}, {} samples selected{}, {} already done, {} written ({} converged, {} not), \
          {} re-solved for warm starts, {:.1} s",

@@ -43,7 +43,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let base_plan = load_plan(base)?;
     let mut ext = StrainExtent::empty();
     for l in logs {
-        StrainExtent::read_log(l, &mut ext, outliers).map_err(anyhow::Error::msg)?;
+        StrainExtent::read_log(l, &mut ext, outliers)?;
     }
     let (plan, r) = scene_plan(&base_plan, &ext, margin);
     plan.validate().map_err(|e| anyhow!("scene plan: {e}"))?;

@@ -5,7 +5,7 @@
 
 use crate::args::exit;
 use anyhow::anyhow;
-use hylc::validate::{psi_conformance, read_json, strain_conformance};
+use hylc::validation::conformance::{psi_conformance, read_json, strain_conformance};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -85,8 +85,45 @@ fn validate(args: &ValidateArgs) -> anyhow::Result<bool> {
     let t0 = Instant::now();
     let mut rows = Vec::new();
 
-    // 3a: conformance with the original macro-scale code
-    let psi = psi_conformance(&shared, 1e-10, 1e-8).map_err(anyhow::Error::msg)?;
+    item_a(&shared, &mut rows)?;
+    println!(
+        "validate: item a (conformance) done, {:.1} s",
+        t0.elapsed().as_secs_f64()
+    );
+
+    // scratch files of items b and c
+    let tmp = std::env::temp_dir().join(format!("hylc_validate_{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).map_err(|e| anyhow!("{}: cannot create: {e}", tmp.display()))?;
+    item_b(&tmp, &mut rows)?;
+    println!(
+        "validate: item b (calibration) done, {:.1} s",
+        t0.elapsed().as_secs_f64()
+    );
+
+    item_c(&shared, &tmp, args.grid_limit, &mut rows)?;
+    println!(
+        "validate: item c (micro grid) done, {:.1} s",
+        t0.elapsed().as_secs_f64()
+    );
+
+    item_d(&mut rows);
+    std::fs::remove_dir_all(&tmp).ok();
+
+    let table = format_table(&rows, args.grid_limit, t0.elapsed().as_secs_f64());
+    std::fs::write(&args.write, &table)
+        .map_err(|e| anyhow!("{}: cannot write: {e}", args.write.display()))?;
+    print!("\n{table}");
+    println!("wrote {}", args.write.display());
+    if let Some(readme) = &args.readme {
+        splice_readme(readme, &table)?;
+        println!("updated the results table in {}", readme.display());
+    }
+    Ok(rows.iter().all(|r| r.pass != Some(false)))
+}
+
+/// Item 3a: conformance with the original macro-scale code (ψ of the five materials, the strain chain).
+fn item_a(shared: &Path, rows: &mut Vec<Row>) -> anyhow::Result<()> {
+    let psi = psi_conformance(shared, 1e-10, 1e-8)?;
     for c in &psi {
         rows.push(Row {
             item: "a",
@@ -97,7 +134,7 @@ fn validate(args: &ValidateArgs) -> anyhow::Result<bool> {
             command: "cargo test --release --test conformance_psi -- --nocapture".into(),
         });
     }
-    let sc = strain_conformance(&shared, 1e-10).map_err(anyhow::Error::msg)?;
+    let sc = strain_conformance(shared, 1e-10)?;
     rows.push(Row {
         item: "a",
         what: format!(
@@ -109,14 +146,11 @@ fn validate(args: &ValidateArgs) -> anyhow::Result<bool> {
         pass: Some(sc.failures.is_empty()),
         command: "cargo test --release --test shell_strain -- --nocapture".into(),
     });
-    println!(
-        "validate: item a (conformance) done, {:.1} s",
-        t0.elapsed().as_secs_f64()
-    );
+    Ok(())
+}
 
-    // 3b: the reference patterns as equilibria at the calibrated defaults
-    let tmp = std::env::temp_dir().join(format!("hylc_validate_{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).map_err(|e| anyhow!("{}: cannot create: {e}", tmp.display()))?;
+/// Item 3b: the reference patterns as equilibria at the calibrated defaults (`hylc calibrate`, its JSON in `tmp`).
+fn item_b(tmp: &Path, rows: &mut Vec<Row>) -> anyhow::Result<()> {
     let cal_json = tmp.join("calibration.json");
     crate::calibrate::run(crate::calibrate::Args {
         dir: None,
@@ -125,7 +159,7 @@ fn validate(args: &ValidateArgs) -> anyhow::Result<bool> {
         radius_factor: "1".into(),
         json: Some(cal_json.clone()),
     })?;
-    let cal = read_json(&cal_json).map_err(anyhow::Error::msg)?;
+    let cal = read_json(&cal_json)?;
     let form = &cal[0];
     let y = hylc::rod::YarnMaterial::default();
     for r in form["rows"].as_array().into_iter().flatten() {
@@ -149,12 +183,16 @@ fn validate(args: &ValidateArgs) -> anyhow::Result<bool> {
             command: "cargo run --release -- calibrate".into(),
         });
     }
-    println!(
-        "validate: item b (calibration) done, {:.1} s",
-        t0.elapsed().as_secs_f64()
-    );
+    Ok(())
+}
 
-    // 3c: our micro solver against the original displacements
+/// Item 3c: our micro solver against the original displacements (`hylc micro-grid`, its JSON in `tmp`).
+fn item_c(
+    shared: &Path,
+    tmp: &Path,
+    grid_limit: Option<usize>,
+    rows: &mut Vec<Row>,
+) -> anyhow::Result<()> {
     for (stem, disp, _) in PATTERNS {
         let pattern = shared.join(format!("data/hylc2020/patterns/{stem}.pyp"));
         let data = shared.join(format!("data/hylc2020/displacements/{disp}"));
@@ -168,12 +206,12 @@ fn validate(args: &ValidateArgs) -> anyhow::Result<bool> {
             &pattern.display().to_string(),
             &data,
             Some(&json),
-            args.grid_limit,
+            grid_limit,
             0,
             false,
             options,
         )?;
-        let v = read_json(&json).map_err(anyhow::Error::msg)?;
+        let v = read_json(&json)?;
         let s = v["runs"]
             .as_object()
             .and_then(|m| m.values().next())
@@ -195,17 +233,16 @@ fn validate(args: &ValidateArgs) -> anyhow::Result<bool> {
             pass: None,
             command: format!(
                 "cargo run --release -- micro-grid ../shared/data/hylc2020/patterns/{stem}.pyp ../shared/data/hylc2020/displacements/{disp}{}",
-                args.grid_limit.map_or(String::new(), |n| format!(" --limit {n}"))
+                grid_limit.map_or(String::new(), |n| format!(" --limit {n}"))
             ),
         });
     }
-    println!(
-        "validate: item c (micro grid) done, {:.1} s",
-        t0.elapsed().as_secs_f64()
-    );
+    Ok(())
+}
 
-    // 3d: our fitted 1D curves against the original materials (from the committed fit reports; rerun with
-    // validation/fit_originals.sh, hours of sampling)
+/// Item 3d: our fitted 1D curves against the original materials, from the committed fit reports (rerun with
+/// `validation/fit_originals.sh`, hours of sampling).
+fn item_d(rows: &mut Vec<Row>) {
     let fit_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/fit");
     for (stem, _, material) in PATTERNS {
         // the full plan's report, else the 1D-only plan's (`PLAN=_1d`)
@@ -271,18 +308,6 @@ fn validate(args: &ValidateArgs) -> anyhow::Result<bool> {
             });
         }
     }
-    std::fs::remove_dir_all(&tmp).ok();
-
-    let table = format_table(&rows, args.grid_limit, t0.elapsed().as_secs_f64());
-    std::fs::write(&args.write, &table)
-        .map_err(|e| anyhow!("{}: cannot write: {e}", args.write.display()))?;
-    print!("\n{table}");
-    println!("wrote {}", args.write.display());
-    if let Some(readme) = &args.readme {
-        splice_readme(readme, &table)?;
-        println!("updated the results table in {}", readme.display());
-    }
-    Ok(rows.iter().all(|r| r.pass != Some(false)))
 }
 
 fn format_table(rows: &[Row], grid_limit: Option<usize>, time: f64) -> String {

@@ -2,6 +2,7 @@
 //! measurements behind `hylc validate` and the conformance tests. Each function reads `../shared` (the caller
 //! passes the folder) and returns numbers; the callers decide what passes.
 
+use super::ValidationError;
 use crate::material::Material;
 use crate::shell::{RestTriangle, StrainChain};
 use serde::Serialize;
@@ -23,19 +24,36 @@ pub fn rel_norm(a: &[f64], b: &[f64]) -> f64 {
     d / n.max(f64::MIN_POSITIVE)
 }
 
-fn nums(v: &Value) -> Result<Vec<f64>, String> {
+/// The numbers of a (nested) JSON array or number of the file `path`, flattened.
+fn nums(v: &Value, path: &Path) -> Result<Vec<f64>, ValidationError> {
     match v {
-        Value::Array(a) => Ok(a.iter().map(nums).collect::<Result<Vec<_>, _>>()?.concat()),
+        Value::Array(a) => Ok(a
+            .iter()
+            .map(|x| nums(x, path))
+            .collect::<Result<Vec<_>, _>>()?
+            .concat()),
         Value::Number(n) => Ok(vec![n.as_f64().unwrap_or(f64::NAN)]),
-        _ => Err(format!("expected numbers, got {v}")),
+        _ => Err(data(path, format!("expected numbers, got {v}"))),
+    }
+}
+
+fn data(path: &Path, message: String) -> ValidationError {
+    ValidationError::Data {
+        path: path.to_path_buf(),
+        message,
     }
 }
 
 /// A JSON file, with the file named in the error.
-pub fn read_json(path: &Path) -> Result<Value, String> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
-    serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
+pub fn read_json(path: &Path) -> Result<Value, ValidationError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ValidationError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    serde_json::from_str(&text).map_err(|source| ValidationError::Json {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// Largest relative normwise errors of value, first and second derivatives over a set of oracle cases, and the
@@ -76,32 +94,32 @@ impl Conformance {
 
 /// Item 3a for ψ: ψ, ∇ψ, ∇²ψ of each original material against `oracles/psi_oracle.json`; cases beyond `tol`
 /// (value and gradient) or `tol_hess` are listed.
-pub fn psi_conformance(shared: &Path, tol: f64, tol_hess: f64) -> Result<Vec<Conformance>, String> {
+pub fn psi_conformance(
+    shared: &Path,
+    tol: f64,
+    tol_hess: f64,
+) -> Result<Vec<Conformance>, ValidationError> {
     let path = shared.join("oracles/psi_oracle.json");
     let oracle = read_json(&path)?;
     let mut out = Vec::new();
     for name in ORIGINAL_MATERIALS {
-        let mat = Material::load(&shared.join(format!("data/hylc2020/materials/{name}.json")))
-            .map_err(|e| e.to_string())?;
+        let mat = Material::load(&shared.join(format!("data/hylc2020/materials/{name}.json")))?;
         let samples = oracle["materials"][name]["samples"]
             .as_array()
-            .ok_or_else(|| format!("{}: no samples for {name}", path.display()))?;
+            .ok_or_else(|| data(&path, format!("no samples for {name}")))?;
         let mut c = Conformance::new(name, samples.len());
         for s in samples {
-            let z = nums(&s["z"])?;
+            let z = nums(&s["z"], &path)?;
             if z.len() != 6 {
-                return Err(format!(
-                    "{}: {name}: a strain without 6 entries",
-                    path.display()
-                ));
+                return Err(data(&path, format!("{name}: a strain without 6 entries")));
             }
             let r = mat.eval(&[z[0], z[1], z[2], z[3], z[4], z[5]]);
             let hv: Vec<f64> = r.hess.iter().flatten().copied().collect();
             let psi = s["psi"].as_f64().unwrap_or(f64::NAN);
             let e = [
                 rel_norm(&[r.value], &[psi]),
-                rel_norm(&r.grad, &nums(&s["grad"])?),
-                rel_norm(&hv, &nums(&s["hess"])?),
+                rel_norm(&r.grad, &nums(&s["grad"], &path)?),
+                rel_norm(&hv, &nums(&s["hess"], &path)?),
             ];
             c.add(e, [tol, tol, tol_hess], || {
                 format!(
@@ -117,24 +135,20 @@ pub fn psi_conformance(shared: &Path, tol: f64, tol_hess: f64) -> Result<Vec<Con
 
 /// Item 3a for the strain chain: z, the 6×18 Jacobian and the 6×18×18 Hessian of `oracles/strain_oracle.json`'s
 /// cases, at the stored positions and translated 2 m from the origin; cases beyond `tol` are listed.
-pub fn strain_conformance(shared: &Path, tol: f64) -> Result<Conformance, String> {
+pub fn strain_conformance(shared: &Path, tol: f64) -> Result<Conformance, ValidationError> {
     let path = shared.join("oracles/strain_oracle.json");
     let oracle = read_json(&path)?;
     let cases = oracle["cases"]
         .as_array()
-        .ok_or_else(|| format!("{}: no cases", path.display()))?;
+        .ok_or_else(|| data(&path, "no cases".into()))?;
     let mut c = Conformance::new("strain chain", 2 * cases.len());
     for shift in [0.0, 2.0] {
         for case in cases {
-            let xloc = nums(&case["xloc"])?;
-            let d = nums(&case["invDm"])?;
-            let ex = nums(&case["niexists"])?;
+            let xloc = nums(&case["xloc"], &path)?;
+            let d = nums(&case["invDm"], &path)?;
+            let ex = nums(&case["niexists"], &path)?;
             if xloc.len() != 18 || d.len() != 4 || ex.len() != 3 {
-                return Err(format!(
-                    "{}: case {}: malformed",
-                    path.display(),
-                    case["id"]
-                ));
+                return Err(data(&path, format!("case {}: malformed", case["id"])));
             }
             let flaps = [ex[0] != 0.0, ex[1] != 0.0, ex[2] != 0.0];
             let rest = RestTriangle::from_inv_dm([[d[0], d[1]], [d[2], d[3]]]);
@@ -149,13 +163,8 @@ pub fn strain_conformance(shared: &Path, tol: f64) -> Result<Conformance, String
                         shift * [1.0, -0.6, 0.8][j % 3]
                     };
             }
-            let chain = StrainChain::new(&q, &rest, flaps).ok_or_else(|| {
-                format!(
-                    "{}: case {}: degenerate triangle",
-                    path.display(),
-                    case["id"]
-                )
-            })?;
+            let chain = StrainChain::new(&q, &rest, flaps)
+                .ok_or_else(|| data(&path, format!("case {}: degenerate triangle", case["id"])))?;
             let mut z = chain.z;
             // the original's stretches are not shifted by 1
             z[0] += 1.0;
@@ -168,9 +177,9 @@ pub fn strain_conformance(shared: &Path, tol: f64) -> Result<Conformance, String
                 hess.extend(chain.weighted_hessian(&w).iter().flatten().copied());
             }
             let e = [
-                rel_norm(&z, &nums(&case["value"])?),
-                rel_norm(&jac, &nums(&case["grad"])?),
-                rel_norm(&hess, &nums(&case["hess"])?),
+                rel_norm(&z, &nums(&case["value"], &path)?),
+                rel_norm(&jac, &nums(&case["grad"], &path)?),
+                rel_norm(&hess, &nums(&case["hess"], &path)?),
             ];
             c.add(e, [tol; 3], || {
                 format!(

@@ -13,10 +13,10 @@
 //! Residual reported: ‖∇E‖ / ‖∇E_rods‖ with ‖∇E_rods‖ = (‖Y a_s‖² + ‖γY a_b‖² + ‖γG a_t‖²)^½, the size of the rod
 //! forces that have to cancel (a pattern balanced by its rods alone still has large individual rod forces).
 
-use super::{Terms, Tile, Want};
 use crate::contact::ContactError;
 use crate::pattern::Pattern;
 use crate::rod::{RodState, YarnMaterial};
+use crate::tile::{Terms, Tile, Want};
 use nalgebra::{DMatrix, DVector};
 
 /// The contact model variant of a calibration: quadrature order, exclusion along the yarn, contact radius factor

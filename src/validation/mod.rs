@@ -1,0 +1,35 @@
+//! Verification and validation against the original method's data (`../shared/design/06-verification.md`,
+//! section 3), kept out of the numerical core: the stages below know nothing of it.
+//!
+//! - [`conformance`]: ψ and the strain chain against the original code's oracle vectors (item 3a);
+//! - [`calibration`]: the yarn parameters that make the original reference patterns static equilibria (item 3b);
+//! - [`grid`]: our micro solver against the original solver's displacements on the 9×9×9 grid (item 3c).
+//!
+//! Each reads `../shared` (the caller passes the folder or files) and returns numbers; the callers (`hylc
+//! validate`, `hylc calibrate`, `hylc micro-grid`, the conformance tests) decide what passes.
+
+pub mod calibration;
+pub mod conformance;
+pub mod grid;
+
+use std::path::PathBuf;
+
+/// Reading the original data failed: the file, and what is wrong with it.
+#[derive(Debug, thiserror::Error)]
+pub enum ValidationError {
+    #[error("{}: cannot read: {source}", path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: {source}", path.display())]
+    Json {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
+    /// The file was read but its content is not what it should be.
+    #[error("{}: {message}", path.display())]
+    Data { path: PathBuf, message: String },
+    #[error(transparent)]
+    Material(#[from] crate::material::MaterialError),
+}
