@@ -10,6 +10,20 @@
 //!
 //! Nothing here prints: what a terminal would show goes to an [`Event`] callback (`Send`, because sampling reports
 //! its progress from the worker threads).
+//!
+//! ```no_run
+//! use hylc::workflow::{pipeline::{run, RunConfig}, Event};
+//!
+//! let config = RunConfig { patterns: vec!["plain".into()], out: "out/plain".into(), ..RunConfig::default() };
+//! let summary = run(&config, &mut |e| match e {
+//!     Event::Log(line) => println!("{line}"),
+//!     Event::Samples { done, todo } => eprint!("\rsample {done}/{todo}"),
+//!     Event::Step { done, total, .. } => eprint!("\rdrape step {done}/{total}"),
+//!     _ => {}
+//! })?;
+//! println!("{}", summary["total_time"]);
+//! # Ok::<(), hylc::workflow::WorkflowError>(())
+//! ```
 
 pub mod fit;
 pub mod inputs;

@@ -3,6 +3,7 @@
 use clap::ValueEnum;
 use hylc::micro::reference::Construction;
 use hylc::micro::SolverOptions;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// The micro solver's stopping rules (`hylc solve`, `sample`, `micro-grid`).
@@ -28,6 +29,27 @@ impl SolverArgs {
             time_limit: self.time_limit,
             ..Default::default()
         }
+    }
+}
+
+/// Where a command writes its report as JSON (`hylc reference`, `hylc calibrate`).
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct OutputArgs {
+    /// also write the report as JSON to this file
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+impl OutputArgs {
+    /// Write `report` as pretty JSON (with a final newline) when `--json` was given; the file's path when written.
+    pub fn write_report<T: serde::Serialize>(&self, report: &T) -> anyhow::Result<Option<&Path>> {
+        let Some(path) = &self.json else {
+            return Ok(None);
+        };
+        let text = serde_json::to_string_pretty(report)?;
+        std::fs::write(path, text + "\n")
+            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
+        Ok(Some(path))
     }
 }
 

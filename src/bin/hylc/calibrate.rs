@@ -1,7 +1,7 @@
 //! `hylc calibrate`: the yarn-parameter calibration against the original reference patterns
 //! (`06-verification.md` item b; `hylc::validation::calibration`).
 
-use crate::args::parse_list;
+use crate::args::{parse_list, OutputArgs};
 use anyhow::anyhow;
 use hylc::pattern::Pattern;
 use hylc::rod::YarnMaterial;
@@ -27,9 +27,8 @@ pub struct Args {
     /// contact radius factors to try (contact distance 2 x factor x r)
     #[arg(long, default_value = "1")]
     pub radius_factor: String,
-    /// write all rows as JSON
-    #[arg(long)]
-    pub json: Option<PathBuf>,
+    #[command(flatten)]
+    pub output: OutputArgs,
 }
 
 /// The original patterns, the set the joint fit uses, and the file names.
@@ -144,10 +143,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             }
         }
     }
-    if let Some(path) = &a.json {
-        let text = serde_json::to_string_pretty(&all)?;
-        std::fs::write(path, text + "\n")
-            .map_err(|e| anyhow!("{}: cannot write: {e}", path.display()))?;
+    if let Some(path) = a.output.write_report(&all)? {
         println!("\nwrote {}", path.display());
     }
     Ok(ExitCode::SUCCESS)

@@ -1,7 +1,7 @@
 //! `hylc reference PATTERN --out REF.pyp`: Algorithm C1 on a pattern (`03-homogenization.md`, section 6;
 //! `hylc::micro::reference`), written as `.pyp`.
 
-use crate::args::ConstructionArg;
+use crate::args::{ConstructionArg, OutputArgs};
 use crate::strain::load_pattern_noted;
 use anyhow::anyhow;
 use hylc::micro::reference::{reference_state, Construction, ReferenceOptions};
@@ -27,9 +27,8 @@ pub struct Args {
     /// output `.pyp` file
     #[arg(long)]
     out: PathBuf,
-    /// write the report as JSON
-    #[arg(long)]
-    json: Option<PathBuf>,
+    #[command(flatten)]
+    output: OutputArgs,
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
@@ -73,9 +72,6 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         report.time,
         out.display()
     );
-    if let Some(path) = &a.json {
-        let text = serde_json::to_string_pretty(&report)?;
-        std::fs::write(path, text).map_err(|e| anyhow!("{}: cannot write: {e}", path.display()))?;
-    }
+    a.output.write_report(&report)?;
     Ok(ExitCode::SUCCESS)
 }

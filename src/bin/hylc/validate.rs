@@ -157,7 +157,9 @@ fn item_b(tmp: &Path, rows: &mut Vec<Row>) -> anyhow::Result<()> {
         quadrature: "4".into(),
         exclusion: "3".into(),
         radius_factor: "1".into(),
-        json: Some(cal_json.clone()),
+        output: crate::args::OutputArgs {
+            json: Some(cal_json.clone()),
+        },
     })?;
     let cal = read_json(&cal_json)?;
     let form = &cal[0];
