@@ -9,7 +9,7 @@
 //! strain (ũ = 0), and perturbations of 0.05 r / 0.1 rad and 0.2 r / 0.3 rad (θ also shifted by ±2π). Scales
 //! as for the whole-tile row ([`crate::tile`]).
 
-use crate::checks::tile::reference_energy;
+use crate::checks::tile::{contact_kink_distance, reference_energy};
 use crate::contact::GaussLegendre;
 use crate::diff::{Check, Differentiable, Scales, Vgh};
 use crate::micro::elimination::{stencil_copies, Elimination};
@@ -104,19 +104,7 @@ impl StrainCase {
         if i >= 3 * self.problem.pattern.len() {
             return f64::INFINITY;
         }
-        let tile = self.tile();
-        let two_r = 2.0 * self.problem.pattern.radius;
-        let mut gap = f64::INFINITY;
-        for pair in &self.contacts {
-            let p = pair.points(&tile).map(|(v, o)| tile.position(x, v, o));
-            for &s in self.rule.nodes() {
-                for &t in self.rule.nodes() {
-                    let d = (p[0] * (1.0 - s) + p[1] * s) - (p[2] * (1.0 - t) + p[3] * t);
-                    gap = gap.min((d.norm() - two_r).abs());
-                }
-            }
-        }
-        gap
+        contact_kink_distance(&self.tile(), x, &self.contacts, &self.rule)
     }
     fn reference<D: Real>(&self, y: &[D]) -> D {
         let tile = self.tile();

@@ -97,19 +97,7 @@ impl Differentiable for TileCheck {
         if i >= 3 * self.pattern.len() {
             return f64::INFINITY;
         }
-        let tile = self.tile();
-        let two_r = 2.0 * self.pattern.radius;
-        let mut gap = f64::INFINITY;
-        for pair in &self.contacts {
-            let p = pair.points(&tile).map(|(v, o)| tile.position(x, v, o));
-            for &s in self.rule.nodes() {
-                for &t in self.rule.nodes() {
-                    let d = (p[0] * (1.0 - s) + p[1] * s) - (p[2] * (1.0 - t) + p[3] * t);
-                    gap = gap.min((d.norm() - two_r).abs());
-                }
-            }
-        }
-        gap
+        contact_kink_distance(&self.tile(), x, &self.contacts, &self.rule)
     }
     fn reference<D: Real>(&self, y: &[D]) -> D {
         let tile = self.tile();
@@ -164,6 +152,28 @@ impl Differentiable for TileCheck {
         }
         y
     }
+}
+
+/// Distance of the tile's positions `x` from the contact kinks: min over the contact pairs' quadrature node pairs
+/// of |‖d_pq‖ − 2r| (the pair energy is only C¹ where a node distance crosses the contact diameter).
+pub(super) fn contact_kink_distance(
+    tile: &Tile,
+    x: &[f64],
+    contacts: &[crate::tile::ContactPair],
+    rule: &GaussLegendre,
+) -> f64 {
+    let two_r = 2.0 * tile.pattern.radius;
+    let mut gap = f64::INFINITY;
+    for pair in contacts {
+        let p = pair.points(tile).map(|(v, o)| tile.position(x, v, o));
+        for &s in rule.nodes() {
+            for &t in rule.nodes() {
+                let d = (p[0] * (1.0 - s) + p[1] * s) - (p[2] * (1.0 - t) + p[3] * t);
+                gap = gap.min((d.norm() - two_r).abs());
+            }
+        }
+    }
+    gap
 }
 
 /// The plain sum of the stencils' reference twins over a tile's stencils and contact pairs, with the world
