@@ -28,7 +28,7 @@ use super::mesh::Stencil;
 use super::ShellError;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::sparse::SparseColMatRef;
 use faer::Side;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -260,14 +260,7 @@ impl Simulation {
             ));
         }
         let pattern = Pattern::new(&stencils, n, &constrained);
-        let sym = SymbolicSparseColMatRef::new_checked(
-            3 * pattern.nfree,
-            3 * pattern.nfree,
-            &pattern.col_ptr,
-            None,
-            &pattern.row_idx,
-        );
-        let symbolic = SymbolicLlt::try_new(sym, Side::Lower)
+        let symbolic = SymbolicLlt::try_new(pattern.lower.symbolic(), Side::Lower)
             .map_err(|e| ShellError(format!("symbolic factorisation failed: {e:?}")))?;
         let x: Vec<f64> = x0.iter().flatten().copied().collect();
         if energy(&model, &stencils, &x).is_none() {
@@ -610,26 +603,15 @@ impl Simulation {
         g: &[f64],
     ) -> Result<(Vec<f64>, f64), ShellError> {
         let nf = g.len();
-        let sym = SymbolicSparseColMatRef::new_checked(
-            nf,
-            nf,
-            &self.pattern.col_ptr,
-            None,
-            &self.pattern.row_idx,
-        );
         if !exact.is_empty() {
-            let mat = SparseColMatRef::new(sym, exact);
-            if let Ok(llt) = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower) {
-                let mut d: Vec<f64> = g.iter().map(|x| -x).collect();
-                llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut d, nf, 1));
-                if d.iter().all(|x| x.is_finite()) {
-                    return Ok((d, 0.0));
-                }
+            if let Some(d) = self.factor_solve(exact, g) {
+                return Ok((d, 0.0));
             }
         }
         let mut shift = 0.0;
         let mean_diag = self
             .pattern
+            .lower
             .diag
             .iter()
             .map(|&k| values[k].abs())
@@ -643,24 +625,31 @@ impl Simulation {
                 } else {
                     10.0 * shift
                 };
-                for &k in &self.pattern.diag {
+                for &k in &self.pattern.lower.diag {
                     vals[k] += new_shift - shift;
                 }
                 shift = new_shift;
             }
-            let mat = SparseColMatRef::new(sym, &vals);
-            if let Ok(llt) = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower) {
-                let mut d: Vec<f64> = g.iter().map(|x| -x).collect();
-                llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut d, nf, 1));
-                if d.iter().all(|x| x.is_finite()) {
-                    return Ok((d, shift));
-                }
+            if let Some(d) = self.factor_solve(&vals, g) {
+                return Ok((d, shift));
             }
         }
         Err(ShellError(format!(
             "step {}: the Newton system could not be factorised even with a diagonal shift",
             self.steps + 1
         )))
+    }
+
+    /// d = −H⁻¹ g for the free-dof matrix H with the lower-triangle `values` (the pattern's order): the numeric
+    /// Cholesky factorisation with the simulation's symbolic analysis, then one solve. `None` when H is not
+    /// positive definite or d is not finite.
+    fn factor_solve(&self, values: &[f64], g: &[f64]) -> Option<Vec<f64>> {
+        let nf = g.len();
+        let mat = SparseColMatRef::new(self.pattern.lower.symbolic(), values);
+        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower).ok()?;
+        let mut d: Vec<f64> = g.iter().map(|x| -x).collect();
+        llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut d, nf, 1));
+        d.iter().all(|x| x.is_finite()).then_some(d)
     }
 }
 
