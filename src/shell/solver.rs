@@ -22,7 +22,7 @@
 //! p = δ − d > 0 into the layer of thickness δ around the surface (d the signed distance); C² at p = 0. Its
 //! Hessian keeps the PSD part 2 m k p n̂n̂ᵀ (the sphere's curvature term is negative and dropped).
 
-use super::assemble::{assemble, energy, Pattern};
+use super::assemble::{assemble, energy, Assembled, Pattern};
 use super::element::ElementModel;
 use super::mesh::Stencil;
 use super::ShellError;
@@ -211,6 +211,21 @@ struct Target {
     xn: Vec<f64>,
 }
 
+/// Where the Newton iterations of a step ended.
+struct Minimum {
+    x: Vec<f64>,
+    /// Newton iterations taken
+    newton: usize,
+    /// largest residual force on a free vertex at x (N)
+    residual: f64,
+    converged: bool,
+    /// the largest diagonal shift a factorisation needed
+    max_shift: f64,
+    /// the assembly and the full gradient of Φ at x
+    asm: Assembled,
+    g_full: Vec<f64>,
+}
+
 impl Simulation {
     /// Set up a simulation: `x0` the initial positions (3 per vertex), `mass_multiplier` scales the lumped mass
     /// from the material density.
@@ -349,12 +364,63 @@ impl Simulation {
         (val, ())
     }
 
-    /// Advance one step.
+    /// Advance one step: minimise Φ from the start of the step ([`start_of_step`](Self::start_of_step)) by
+    /// Newton's method ([`minimise`](Self::minimise)), then take the minimiser as the new state.
     pub fn step(&mut self) -> Result<StepReport, ShellError> {
         let start = Instant::now();
-        let s = self.settings.clone();
-        let h = s.dt;
+        let h = self.settings.dt;
         let t1 = self.time + h;
+        let (tg, x) = self.start_of_step(t1);
+        let phi = self.potential(&x, &tg).ok_or_else(|| {
+            ShellError(format!(
+                "step {} (t = {t1:.4} s): a triangle is degenerate at the start of the step (handles moved too far in one step?)",
+                self.steps + 1
+            ))
+        })?;
+        let m = self.minimise(x, &tg, phi)?;
+        // reactions: the full gradient of Φ at the handle vertices (`asm` and `g_full` are evaluated at x,
+        // except after a failed line search, where x did not change either)
+        let handle_forces = self.handle_forces(&m.g_full);
+        // update state
+        let x = m.x;
+        for i in 0..x.len() {
+            self.v[i] = if self.settings.quasi_static {
+                0.0
+            } else {
+                (x[i] - tg.xn[i]) / h
+            };
+        }
+        self.x = x;
+        self.time = t1;
+        self.steps += 1;
+        let (ek, eg, eo) = self.energies();
+        let asm = m.asm;
+        Ok(StepReport {
+            step: self.steps,
+            time: self.time,
+            newton: m.newton,
+            residual: m.residual,
+            converged: m.converged,
+            energy_elastic: asm.energy,
+            energy_kinetic: ek,
+            energy_gravity: eg,
+            energy_obstacles: eo,
+            handle_forces,
+            shift: m.max_shift,
+            wall: start.elapsed().as_secs_f64(),
+            strain_min: asm.zmin,
+            strain_max: asm.zmax,
+            strain_p01: strain_quantile(&asm.z, 0.01),
+            strain_p99: strain_quantile(&asm.z, 0.99),
+        })
+    }
+
+    /// The constants of the step ending at `t1` (x̃ = xₙ + h vₙ, xₙ) and the starting point of its minimisation:
+    /// pinned and handle vertices at their prescribed positions, the free ones at the inertial prediction x̃ when Φ
+    /// is defined there, else at xₙ (always xₙ in quasi-static mode).
+    fn start_of_step(&self, t1: f64) -> (Target, Vec<f64>) {
+        let s = &self.settings;
+        let h = s.dt;
         let n = self.pattern.n;
         let xn = self.x.clone();
         let mut xt = xn.clone();
@@ -396,74 +462,100 @@ impl Simulation {
                 x = guess;
             }
         }
-        let mut phi = self.potential(&x, &tg).ok_or_else(|| {
-            ShellError(format!(
-                "step {} (t = {t1:.4} s): a triangle is degenerate at the start of the step (handles moved too far in one step?)",
-                self.steps + 1
-            ))
-        })?;
+        (tg, x)
+    }
+
+    /// Newton's method on Φ from `x` (where Φ = `phi`): converged when the largest residual force on a free
+    /// vertex is below the tolerance (or there is no free vertex); stops unconverged after `max_newton`
+    /// iterations or when the line search finds no decrease.
+    fn minimise(&self, mut x: Vec<f64>, tg: &Target, mut phi: f64) -> Result<Minimum, ShellError> {
+        let s = &self.settings;
         let nf = 3 * self.pattern.nfree;
         let mut newton = 0;
-        let mut residual;
-        let mut converged = false;
         let mut max_shift: f64 = 0.0;
-        let (mut last, mut g_full);
         loop {
-            (last, g_full) = self.gradient_hessian(&x, &tg)?;
-            // residual over free vertices
-            let mut gf = vec![0.0; nf];
-            residual = 0.0f64;
-            for v in 0..n {
-                if let Some(k) = self.pattern.free[v] {
-                    let f2: f64 = (0..3).map(|c| g_full[3 * v + c].powi(2)).sum();
-                    residual = residual.max(f2.sqrt());
-                    for c in 0..3 {
-                        gf[3 * k + c] = g_full[3 * v + c];
-                    }
+            let (asm, g_full) = self.gradient_hessian(&x, tg)?;
+            let (gf, residual) = self.free_gradient(&g_full);
+            let converged = residual <= s.force_tol || nf == 0;
+            let mut step = None;
+            if !converged && newton < s.max_newton {
+                newton += 1;
+                let (d, shift) = self.solve(&asm.values, &asm.values_exact, &gf)?;
+                max_shift = max_shift.max(shift);
+                let slope: f64 = gf.iter().zip(&d).map(|(a, b)| a * b).sum();
+                step = self.line_search(&x, &d, slope, phi, tg);
+            }
+            match step {
+                Some((xtry, p)) => {
+                    x = xtry;
+                    phi = p;
+                }
+                None => {
+                    return Ok(Minimum {
+                        x,
+                        newton,
+                        residual,
+                        converged,
+                        max_shift,
+                        asm,
+                        g_full,
+                    })
                 }
             }
-            if residual <= s.force_tol || nf == 0 {
-                converged = true;
-                break;
-            }
-            if newton >= s.max_newton {
-                break;
-            }
-            newton += 1;
-            let (d, shift) = self.solve(&last.values, &last.values_exact, &gf)?;
-            max_shift = max_shift.max(shift);
-            let slope: f64 = gf.iter().zip(&d).map(|(a, b)| a * b).sum();
-            let mut alpha = 1.0;
-            let mut accepted = false;
-            let mut xtry = x.clone();
-            while alpha > 1e-12 {
-                for v in 0..n {
-                    if let Some(k) = self.pattern.free[v] {
-                        for c in 0..3 {
-                            xtry[3 * v + c] = x[3 * v + c] + alpha * d[3 * k + c];
-                        }
-                    }
-                }
-                if let Some(p) = self.potential(&xtry, &tg) {
-                    // Armijo, with an allowance for round-off in Φ near convergence
-                    if p <= phi + 1e-4 * alpha * slope + 1e-13 * phi.abs() {
-                        phi = p;
-                        accepted = true;
-                        break;
-                    }
-                }
-                alpha *= 0.5;
-            }
-            if !accepted {
-                break;
-            }
-            std::mem::swap(&mut x, &mut xtry);
         }
-        let asm = last;
-        // reactions: the full gradient of Φ at the handle vertices (`last` and `g_full` are evaluated at x,
-        // except after a failed line search, where x did not change either)
-        let handle_forces = self
-            .handles
+    }
+
+    /// The gradient of Φ over the free dofs (free index order) and the largest residual force ‖∂Φ/∂x_v‖ on a free
+    /// vertex.
+    fn free_gradient(&self, g_full: &[f64]) -> (Vec<f64>, f64) {
+        let mut gf = vec![0.0; 3 * self.pattern.nfree];
+        let mut residual = 0.0f64;
+        for v in 0..self.pattern.n {
+            if let Some(k) = self.pattern.free[v] {
+                let f2: f64 = (0..3).map(|c| g_full[3 * v + c].powi(2)).sum();
+                residual = residual.max(f2.sqrt());
+                for c in 0..3 {
+                    gf[3 * k + c] = g_full[3 * v + c];
+                }
+            }
+        }
+        (gf, residual)
+    }
+
+    /// Backtracking (Armijo) line search on Φ from `x` along the free-dof direction `d` with slope gᵀd: steps
+    /// α = 1, ½, … down to 1e-12. Returns the accepted point and its Φ.
+    fn line_search(
+        &self,
+        x: &[f64],
+        d: &[f64],
+        slope: f64,
+        phi: f64,
+        tg: &Target,
+    ) -> Option<(Vec<f64>, f64)> {
+        let mut alpha = 1.0;
+        let mut xtry = x.to_vec();
+        while alpha > 1e-12 {
+            for v in 0..self.pattern.n {
+                if let Some(k) = self.pattern.free[v] {
+                    for c in 0..3 {
+                        xtry[3 * v + c] = x[3 * v + c] + alpha * d[3 * k + c];
+                    }
+                }
+            }
+            if let Some(p) = self.potential(&xtry, tg) {
+                // Armijo, with an allowance for round-off in Φ near convergence
+                if p <= phi + 1e-4 * alpha * slope + 1e-13 * phi.abs() {
+                    return Some((xtry, p));
+                }
+            }
+            alpha *= 0.5;
+        }
+        None
+    }
+
+    /// The force each handle exerts on the cloth: the sum of the full gradient of Φ over its vertices.
+    fn handle_forces(&self, g_full: &[f64]) -> Vec<(String, [f64; 3])> {
+        self.handles
             .iter()
             .map(|hd| {
                 let mut f = [0.0; 3];
@@ -474,22 +566,17 @@ impl Simulation {
                 }
                 (hd.name.clone(), f)
             })
-            .collect();
-        // update state
-        for i in 0..x.len() {
-            self.v[i] = if s.quasi_static {
-                0.0
-            } else {
-                (x[i] - xn[i]) / h
-            };
-        }
-        self.x = x;
-        self.time = t1;
-        self.steps += 1;
+            .collect()
+    }
+
+    /// Kinetic energy, gravitational potential energy relative to the initial state and obstacle energy of the
+    /// current state.
+    fn energies(&self) -> (f64, f64, f64) {
+        let s = &self.settings;
         let mut ek = 0.0;
         let mut eg = 0.0;
         let mut eo = 0.0;
-        for v in 0..n {
+        for v in 0..self.pattern.n {
             let m = self.mass[v];
             let p = [self.x[3 * v], self.x[3 * v + 1], self.x[3 * v + 2]];
             for c in 0..3 {
@@ -498,24 +585,7 @@ impl Simulation {
             }
             eo += self.obstacle_terms(v, p).0;
         }
-        Ok(StepReport {
-            step: self.steps,
-            time: self.time,
-            newton,
-            residual,
-            converged,
-            energy_elastic: asm.energy,
-            energy_kinetic: ek,
-            energy_gravity: eg,
-            energy_obstacles: eo,
-            handle_forces,
-            shift: max_shift,
-            wall: start.elapsed().as_secs_f64(),
-            strain_min: asm.zmin,
-            strain_max: asm.zmax,
-            strain_p01: strain_quantile(&asm.z, 0.01),
-            strain_p99: strain_quantile(&asm.z, 0.99),
-        })
+        (ek, eg, eo)
     }
 
     /// The first Newton direction of the next step at the current state (assembly, factorisation, solve): one
@@ -547,7 +617,7 @@ impl Simulation {
         &self,
         x: &[f64],
         tg: &Target,
-    ) -> Result<(super::assemble::Assembled, Vec<f64>), ShellError> {
+    ) -> Result<(Assembled, Vec<f64>), ShellError> {
         let s = &self.settings;
         let h = s.dt;
         let mut asm = assemble(
