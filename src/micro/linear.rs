@@ -19,7 +19,7 @@ use nalgebra::{DMatrix, DVector};
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum FactorError {
     /// H + μI is not numerically positive definite.
-    #[error("the shifted Newton matrix H + mu I is not positive definite")]
+    #[error("the shifted Newton matrix H + μI is not positive definite")]
     NotPositiveDefinite,
     /// The Schur complement of the constraints is singular (dependent constraint rows).
     #[error("the constraint rows are dependent (singular Schur complement)")]

@@ -11,7 +11,9 @@
 //! The result is a [`Pattern`] like a loaded `.pyp` file (and writable as one).
 
 use super::envelope::energy_strain_gradient;
-use super::solver::{world_positions, MicroError, MicroProblem, MicroState, SolverOptions};
+use super::solver::{
+    world_positions, MicroError, MicroProblem, MicroState, NotConverged, SolverOptions,
+};
 use super::strain::MacroStrain;
 use crate::pattern::Pattern;
 use crate::rod::{set_rest_to_current, YarnMaterial};
@@ -88,27 +90,48 @@ pub struct ReferenceReport {
 }
 
 /// Why the reference computation failed.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum ReferenceError {
-    Solve(MicroError),
-    NotConverged(String),
+    #[error(transparent)]
+    Solve(#[from] MicroError),
+    /// A micro solve of the computation did not converge; `stage` says which ("stress-free round 3", "in-plane
+    /// minimum at (…)", "final reference state").
+    #[error("{stage}: {source}")]
+    Unconverged { stage: String, source: NotConverged },
+    /// Step 1 did not reach a stress-free state within the allowed rounds.
+    #[error(
+        "no stress-free state after {rounds} rounds: relaxed energy {energy:.3e} J (target {target:.3e} J)"
+    )]
+    NoStressFreeState {
+        rounds: usize,
+        energy: f64,
+        target: f64,
+    },
+    /// Step 3 did not reach zero tile forces within the allowed Newton steps.
+    #[error(
+        "no zero-stress periods after {steps} Newton steps: tile forces {:.3e}, {:.3e} N (target {tolerance:.1e} N)",
+        .force[0],
+        .force[1]
+    )]
+    NoZeroStressPeriods {
+        steps: usize,
+        force: [f64; 2],
+        tolerance: f64,
+    },
+    /// Step 3 found no strain step that lowers the tile forces.
+    #[error(
+        "the zero-stress search stalled at s = ({:.3e}, {:.3e}) with tile forces {:.3e}, {:.3e} N",
+        .s[0],
+        .s[1],
+        .force[0],
+        .force[1]
+    )]
+    PeriodSearchStalled { s: [f64; 2], force: [f64; 2] },
 }
 
-impl std::fmt::Display for ReferenceError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            ReferenceError::Solve(e) => write!(f, "{e}"),
-            ReferenceError::NotConverged(m) => write!(f, "{m}"),
-        }
-    }
-}
-
-impl std::error::Error for ReferenceError {}
-
-impl From<MicroError> for ReferenceError {
-    fn from(e: MicroError) -> Self {
-        ReferenceError::Solve(e)
-    }
+/// The error of a micro solve at `stage` that did not converge.
+fn unconverged(stage: String) -> impl FnOnce(NotConverged) -> ReferenceError {
+    move |source| ReferenceError::Unconverged { stage, source }
 }
 
 /// Write an in-plane equilibrium (s_a = 0, no bending) back into a pattern: world positions become the reference
@@ -171,7 +194,7 @@ pub fn reference_state(
     let sol = check.solve(&MacroStrain::ZERO, None)?;
     let psi = sol
         .psi()
-        .map_err(|e| ReferenceError::NotConverged(format!("final reference state: {e}")))?;
+        .map_err(unconverged("final reference state".into()))?;
     let report = ReferenceReport {
         rounds,
         stress_free_energy: energy,
@@ -212,9 +235,8 @@ fn stress_free(
         set_rest_to_current(p);
         let problem = MicroProblem::new(p.clone(), &soft, solver.clone());
         let sol = problem.solve(&MacroStrain::ZERO, None)?;
-        sol.psi().map_err(|e| {
-            ReferenceError::NotConverged(format!("stress-free round {rounds}: {e}"))
-        })?;
+        sol.psi()
+            .map_err(unconverged(format!("stress-free round {rounds}")))?;
         energy = sol.energy.total();
         *p = pattern_from_state(p, &sol.state);
         if energy < 1e-10 * ks * mean_rest {
@@ -222,10 +244,11 @@ fn stress_free(
         }
     }
     if energy >= 1e-10 * ks * mean_rest {
-        return Err(ReferenceError::NotConverged(format!(
-            "no stress-free state after {rounds} rounds: relaxed energy {energy:.3e} J (target {:.3e} J)",
-            1e-10 * ks * mean_rest
-        )));
+        return Err(ReferenceError::NoStressFreeState {
+            rounds,
+            energy,
+            target: 1e-10 * ks * mean_rest,
+        });
     }
     if options.stress_free_and_tension {
         set_rest_to_current(p);
@@ -300,7 +323,7 @@ impl PeriodSearch {
         let z = MacroStrain::in_plane(s[0], 0.0, s[1]);
         let sol = self.problem.solve(&z, warm)?;
         sol.psi()
-            .map_err(|e| ReferenceError::NotConverged(format!("in-plane minimum at {z}: {e}")))?;
+            .map_err(unconverged(format!("in-plane minimum at {z}")))?;
         Ok(sol.state)
     }
 
@@ -313,20 +336,20 @@ impl PeriodSearch {
         let mut at = Equilibrium { s, state, force };
         let mut steps = 0;
         while at.force[0].abs().max(at.force[1].abs()) > tol {
-            let (s, f) = (at.s, at.force);
             if steps >= max_steps {
-                return Err(ReferenceError::NotConverged(format!(
-                    "no zero-stress periods after {steps} Newton steps: tile forces {:.3e}, {:.3e} N (target {tol:.1e} N)",
-                    f[0], f[1]
-                )));
+                return Err(ReferenceError::NoZeroStressPeriods {
+                    steps,
+                    force: at.force,
+                    tolerance: tol,
+                });
             }
             steps += 1;
             let ds = self.newton_step(&at)?;
             let Some(next) = self.backtrack(&at, ds)? else {
-                return Err(ReferenceError::NotConverged(format!(
-                    "the zero-stress search stalled at s = ({:.3e}, {:.3e}) with tile forces {:.3e}, {:.3e} N",
-                    s[0], s[1], f[0], f[1]
-                )));
+                return Err(ReferenceError::PeriodSearchStalled {
+                    s: at.s,
+                    force: at.force,
+                });
             };
             at = next;
         }

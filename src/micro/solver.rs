@@ -90,35 +90,30 @@ impl fmt::Display for Status {
 }
 
 /// Errors that stop a solve before it runs or in the middle (bad input, overlapping yarns at the start).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MicroError {
-    Strain(StrainError),
-    Contact(ContactError),
-    Linear(FactorError),
-}
-
-impl fmt::Display for MicroError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            MicroError::Strain(e) => write!(f, "{e}"),
-            MicroError::Contact(e) => write!(f, "contact: {e}"),
-            MicroError::Linear(e) => write!(f, "linear solve: {e:?}"),
-        }
-    }
-}
-
-impl std::error::Error for MicroError {}
-
-impl From<StrainError> for MicroError {
-    fn from(e: StrainError) -> Self {
-        MicroError::Strain(e)
-    }
-}
-
-impl From<ContactError> for MicroError {
-    fn from(e: ContactError) -> Self {
-        MicroError::Contact(e)
-    }
+    #[error(transparent)]
+    Strain(#[from] StrainError),
+    #[error("contact: {0}")]
+    Contact(#[from] ContactError),
+    #[error("linear solve: {0}")]
+    Linear(#[from] FactorError),
+    /// A quantity defined at an equilibrium asked of a solve that did not converge.
+    #[error("{what} need an equilibrium: {source}")]
+    NeedsEquilibrium {
+        what: &'static str,
+        source: NotConverged,
+    },
+    /// A constraint row of [`MicroProblem::with_constraints`] with the wrong number of entries.
+    #[error("constraint row {row} has {len} entries, expected {expected}")]
+    ConstraintLength {
+        row: usize,
+        len: usize,
+        expected: usize,
+    },
+    /// A constraint row of [`MicroProblem::with_constraints`] that cannot be normalised.
+    #[error("constraint row {row} is zero or not finite")]
+    ConstraintRow { row: usize },
 }
 
 /// A yarn state at a macro strain: the unknowns y = (ũ, θ) in the tile's dof layout and the stored frames
@@ -167,24 +162,15 @@ pub struct Solution {
 }
 
 /// Asking for Ψ̄ of a non-converged solve.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "the micro solve did not converge ({status} after {steps} steps, ‖g‖∞ = {gradient_norm:.3e} N)"
+)]
 pub struct NotConverged {
     pub status: Status,
     pub steps: usize,
     pub gradient_norm: f64,
 }
-
-impl fmt::Display for NotConverged {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "the micro solve did not converge ({} after {} steps, ‖g‖∞ = {:.3e} N)",
-            self.status, self.steps, self.gradient_norm
-        )
-    }
-}
-
-impl std::error::Error for NotConverged {}
 
 impl Solution {
     /// Ψ̄ = E / (p₁ p₂) (J/m²) of a converged solve; an error for any other status.
@@ -235,19 +221,20 @@ impl MicroProblem {
     /// Replace the constraint rows (each of length 4n over the unknowns y = (ũ, θ); normalised here), e.g. to pin
     /// one vertex per yarn along its axis as the original solver did. The rows must be independent and, together
     /// with H, leave no free rigid mode.
-    pub fn with_constraints(mut self, rows: Vec<Vec<f64>>) -> Result<Self, String> {
+    pub fn with_constraints(mut self, rows: Vec<Vec<f64>>) -> Result<Self, MicroError> {
         let nd = 4 * self.pattern.len();
         let mut rows = rows;
         for (k, row) in rows.iter_mut().enumerate() {
             if row.len() != nd {
-                return Err(format!(
-                    "constraint row {k} has {} entries, expected {nd}",
-                    row.len()
-                ));
+                return Err(MicroError::ConstraintLength {
+                    row: k,
+                    len: row.len(),
+                    expected: nd,
+                });
             }
             let norm = row.iter().map(|v| v * v).sum::<f64>().sqrt();
             if !(norm.is_finite() && norm > 0.0) {
-                return Err(format!("constraint row {k} is zero or not finite"));
+                return Err(MicroError::ConstraintRow { row: k });
             }
             row.iter_mut().for_each(|v| *v /= norm);
         }

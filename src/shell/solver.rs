@@ -244,10 +244,7 @@ impl Simulation {
         } = boundary;
         let n = x0.len();
         if !(settings.dt > 0.0 && settings.dt.is_finite()) {
-            return Err(ShellError(format!(
-                "time step must be positive, got {}",
-                settings.dt
-            )));
+            return Err(ShellError::TimeStep { dt: settings.dt });
         }
         let mut constrained = vec![false; n];
         for &v in pinned
@@ -255,9 +252,10 @@ impl Simulation {
             .chain(handles.iter().flat_map(|h| h.vertices.iter()))
         {
             if v >= n {
-                return Err(ShellError(format!(
-                    "constrained vertex {v} out of range ({n} vertices)"
-                )));
+                return Err(ShellError::VertexOutOfRange {
+                    vertex: v,
+                    vertices: n,
+                });
             }
             constrained[v] = true;
         }
@@ -269,19 +267,14 @@ impl Simulation {
             }
         }
         if !settings.quasi_static && mass.iter().any(|&m| m.is_nan() || m <= 0.0) {
-            return Err(ShellError(
-                "every vertex needs a positive mass (material density, mass multiplier, unused vertices?)"
-                    .into(),
-            ));
+            return Err(ShellError::Mass);
         }
         let pattern = Pattern::new(&stencils, n, &constrained);
         let symbolic = SymbolicLlt::try_new(pattern.lower.symbolic(), Side::Lower)
-            .map_err(|e| ShellError(format!("symbolic factorisation failed: {e:?}")))?;
+            .map_err(|source| ShellError::Symbolic { source })?;
         let x: Vec<f64> = x0.iter().flatten().copied().collect();
         if energy(&model, &stencils, &x).is_none() {
-            return Err(ShellError(
-                "a triangle is degenerate in the initial state".into(),
-            ));
+            return Err(ShellError::DegenerateInitial);
         }
         Ok(Simulation {
             model,
@@ -371,11 +364,9 @@ impl Simulation {
         let h = self.settings.dt;
         let t1 = self.time + h;
         let (tg, x) = self.start_of_step(t1);
-        let phi = self.potential(&x, &tg).ok_or_else(|| {
-            ShellError(format!(
-                "step {} (t = {t1:.4} s): a triangle is degenerate at the start of the step (handles moved too far in one step?)",
-                self.steps + 1
-            ))
+        let phi = self.potential(&x, &tg).ok_or(ShellError::DegenerateStart {
+            step: self.steps + 1,
+            time: t1,
         })?;
         let m = self.minimise(x, &tg, phi)?;
         // reactions: the full gradient of Φ at the handle vertices (`asm` and `g_full` are evaluated at x,
@@ -628,11 +619,8 @@ impl Simulation {
             true,
             self.exact_first(),
         )
-        .ok_or_else(|| {
-            ShellError(format!(
-                "step {}: a triangle became degenerate",
-                self.steps + 1
-            ))
+        .ok_or(ShellError::Degenerate {
+            step: self.steps + 1,
         })?;
         let mut g = std::mem::take(&mut asm.grad);
         for v in 0..self.pattern.n {
@@ -704,10 +692,9 @@ impl Simulation {
                 return Ok((d, shift));
             }
         }
-        Err(ShellError(format!(
-            "step {}: the Newton system could not be factorised even with a diagonal shift",
-            self.steps + 1
-        )))
+        Err(ShellError::Factorization {
+            step: self.steps + 1,
+        })
     }
 
     /// d = −H⁻¹ g for the free-dof matrix H with the lower-triangle `values` (the pattern's order): the numeric
