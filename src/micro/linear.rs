@@ -4,8 +4,9 @@
 //! [ A          0 ] [ λ  ] = [  0 ]
 //!
 //! solved by one sparse Cholesky factorisation of H + μ I (faer, sequential so that results do not depend on
-//! the thread count; the symbolic analysis is kept and reused while the sparsity structure is unchanged) and the
-//! Schur complement S = A (H + μI)⁻¹ Aᵀ of the few dense constraint rows.
+//! the thread count; the lower-triangle pattern is a [`LowerPattern`] and its symbolic analysis is kept and reused
+//! while the sparsity structure is unchanged) and the Schur complement S = A (H + μI)⁻¹ Aᵀ of the few dense
+//! constraint rows.
 
 use crate::sparse::LowerPattern;
 use faer::dyn_stack::{MemBuffer, MemStack};

@@ -254,8 +254,7 @@ pub const BUILTINS: [&str; 5] = ["stretch-x", "stretch-y", "drape-x", "drape-y",
 pub const SIDE: f64 = 0.3;
 pub const BUILTIN_EDGE: f64 = 0.3 / 51.0;
 
-/// A built-in scene matching the original's tests (30 × 30 cm, 1 s at 1/60 s steps, PSD option `psi`: on the
-/// stretch scene with basket1 it reaches the same states as `full` at about a third of the wall time):
+/// A built-in scene matching the original's tests (30 × 30 cm, 1 s at 1/60 s steps, PSD option `psi`):
 /// - `stretch-x` / `stretch-y`: two strips on opposite sides (67 % of the side long, 7 % of it wide, inset 16.5 %
 ///   from the corners) pulled apart 2 cm each over 0.25 s, then held; gravity on.
 /// - `drape-x` / `drape-y`: the square held at the two corners of its edge along the fabric x (y) axis (vertices

@@ -5,13 +5,13 @@
 //! Φ(x) = ½‖x − x̃‖²_M / h² + (c/2h)‖x − xₙ‖²_M + E(x) − Σ m_v g·x_v + E_obst(x)
 //! (c the linear drag rate, 1/s: implicit drag force −c m v); quasi-static mode minimises E − Σ m g·x + E_obst.
 //! Newton's method with a backtracking (Armijo) line search on Φ; converged when the largest residual force on
-//! a free vertex, ‖∂Φ/∂x_v‖, is below the force tolerance. The sparse Hessian (free dofs only) is factorised by
-//! faer's sparse Cholesky with the symbolic analysis computed once per simulation. With `exact_first` (default) the
-//! exact Hessian is factorised first and the PSD option's Hessian (`05-macro.md`, options (a)–(c)) used only when
-//! that fails (not positive definite): projected Newton far from the solution, Newton's quadratic convergence near
-//! it. If the numeric factorisation of the projected Hessian
-//! fails (an indefinite matrix, possible with [`Psd::None`](super::Psd) or in quasi-static mode) a diagonal shift
-//! μ I is added and increased tenfold until it succeeds.
+//! a free vertex, ‖∂Φ/∂x_v‖, is below the force tolerance. The sparse Hessian (free dofs only, the lower triangle
+//! in the pattern of [`assemble`](super::assemble)) is factorised by faer's sparse Cholesky with the symbolic
+//! analysis computed once per simulation. With `exact_first` (default) the exact Hessian is factorised first and
+//! the PSD option's Hessian (`05-macro.md`, options (a)–(c)) used only when that fails (not positive definite):
+//! projected Newton far from the solution, Newton's quadratic convergence near it. If the numeric factorisation
+//! of the projected Hessian fails (an indefinite matrix, possible with [`Psd::None`](super::Psd) or in
+//! quasi-static mode) a diagonal shift μ I is added and increased tenfold until it succeeds.
 //!
 //! Boundary conditions by dof elimination: pinned vertices keep their initial positions; handle vertices follow
 //! keyframed translations (piecewise linear in time, held after the last key). The reaction force of a handle is
