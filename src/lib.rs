@@ -3,8 +3,9 @@
 //! Stages follow the data flow of `../shared/design/01-architecture.md`. Layers import downwards only (a test,
 //! `tests/layers.rs`, fails on an import against this order); each group below may use the groups above it:
 //!
-//! 1. foundations: [`strain`] (strain components by name), [`real`] (the scalar type of the reference implementations, generic 3-vector operations),
-//!    [`periodic`] (tile offsets, transforms and images), [`diff`] (the derivative harness);
+//! 1. foundations: [`sparse`] (lower-triangle sparse patterns of the Newton matrices), [`strain`] (strain
+//!    components by name), [`real`] (the scalar type of the reference implementations, generic 3-vector
+//!    operations), [`periodic`] (tile offsets, transforms and images), [`diff`] (the derivative harness);
 //! 2. data: [`material`] (the spline energy density ψ(z)), [`pattern`] (yarn topology, `.pyp` files);
 //! 3. yarn mechanics: [`rod`], [`contact`], [`tile`], [`micro`];
 //! 4. homogenization: [`sample`], [`fit`];
@@ -17,6 +18,7 @@
 pub mod diff;
 pub mod periodic;
 pub mod real;
+pub mod sparse;
 pub mod strain;
 // 2. data
 pub mod material;

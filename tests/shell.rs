@@ -284,23 +284,23 @@ fn temp_file(name: &str, text: &str) -> std::path::PathBuf {
 fn bad_obj_files_name_file_and_line() {
     let nonmanifold = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 1 1 0\nf 1 2 3\nf 2 1 4\n# third face on edge 1-2\nf 1 2 5\n";
     let (mesh, _) = Mesh::parse_obj(nonmanifold, "bad.obj").unwrap();
-    let e = mesh.stencils(0.0).unwrap_err().0;
+    let e = mesh.stencils(0.0).unwrap_err().to_string();
     assert!(e.starts_with("bad.obj:9: non-manifold edge (1, 2)"), "{e}");
     let degenerate = "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n";
     let (mesh, _) = Mesh::parse_obj(degenerate, "deg.obj").unwrap();
-    let e = mesh.stencils(0.0).unwrap_err().0;
+    let e = mesh.stencils(0.0).unwrap_err().to_string();
     assert!(e.starts_with("deg.obj:4: degenerate rest triangle"), "{e}");
     let e = Mesh::parse_obj("v 0 0 0\nv 1 0 x\n", "c.obj")
         .unwrap_err()
-        .0;
+        .to_string();
     assert!(e.starts_with("c.obj:2: bad vertex coordinate"), "{e}");
     let e = Mesh::parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n", "i.obj")
         .unwrap_err()
-        .0;
+        .to_string();
     assert!(e.starts_with("i.obj:4: face index 7 out of range"), "{e}");
     let e = Mesh::parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0.5\nf 1 2 3\n", "f.obj")
         .unwrap_err()
-        .0;
+        .to_string();
     assert!(
         e.starts_with("f.obj:3: the rest layout must be flat"),
         "{e}"

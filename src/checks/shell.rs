@@ -477,8 +477,8 @@ impl Differentiable for MeshCheck {
             Some(a) => {
                 let mut h = DMatrix::zeros(n, n);
                 for c in 0..n {
-                    for k in self.pattern.col_ptr[c]..self.pattern.col_ptr[c + 1] {
-                        let r = self.pattern.row_idx[k];
+                    for k in self.pattern.lower.col_ptr[c]..self.pattern.lower.col_ptr[c + 1] {
+                        let r = self.pattern.lower.row_idx[k];
                         h[(r, c)] = a.values[k];
                         h[(c, r)] = a.values[k];
                     }

@@ -22,7 +22,6 @@ pub use broad::{
 pub use pair::{pair_energy_reference, PairKernel, PairVgh};
 
 use nalgebra::Vector3;
-use std::fmt;
 
 /// Smallest normalised quadrature distance ρ = ‖x_a(s_p) − x_b(s_q)‖ / (2r) the kernels accept. Below it they
 /// return [`ContactError::Overlap`]: f(10⁻⁶) ≈ 10¹² per unit weight and the Hessian entries scale like ρ⁻⁶, so a
@@ -30,38 +29,24 @@ use std::fmt;
 pub const RHO_MIN: f64 = 1e-6;
 
 /// Errors of the contact kernels and the broad phase.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum ContactError {
     /// Two quadrature points (node `p` on segment a, node `q` on segment b) are closer than [`RHO_MIN`]·2r.
+    #[error(
+        "contact overlap: quadrature points {p} and {q} at normalised distance rho = {rho:.3e} (below {min:.0e})",
+        min = RHO_MIN
+    )]
     Overlap { rho: f64, p: usize, q: usize },
     /// An input coordinate is NaN.
+    #[error("contact: non-finite input coordinate")]
     NonFinite,
     /// A parameter is out of its range (radius or stiffness not positive and finite, quadrature order 0, …).
+    #[error("contact: invalid parameter: {0}")]
     InvalidParameter(String),
     /// The broad phase needs the tile image with this periodic offset and was not given it.
+    #[error("contact broad phase: no tile image with offset ({}, {})", .offset[0], .offset[1])]
     MissingImage { offset: [i32; 2] },
 }
-
-impl fmt::Display for ContactError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            ContactError::Overlap { rho, p, q } => write!(
-                f,
-                "contact overlap: quadrature points {p} and {q} at normalised distance rho = {rho:.3e} \
-                 (below {RHO_MIN:.0e})"
-            ),
-            ContactError::NonFinite => write!(f, "contact: non-finite input coordinate"),
-            ContactError::InvalidParameter(m) => write!(f, "contact: invalid parameter: {m}"),
-            ContactError::MissingImage { offset } => write!(
-                f,
-                "contact broad phase: no tile image with offset ({}, {})",
-                offset[0], offset[1]
-            ),
-        }
-    }
-}
-
-impl std::error::Error for ContactError {}
 
 impl From<crate::periodic::PeriodicError> for ContactError {
     fn from(e: crate::periodic::PeriodicError) -> Self {

@@ -106,10 +106,9 @@ pub fn parameter_derivatives(
     problem: &MicroProblem,
     sol: &Solution,
 ) -> Result<[f64; 5], MicroError> {
-    sol.psi().map_err(|e| {
-        MicroError::Linear(super::linear::FactorError::Other(format!(
-            "parameter derivatives need an equilibrium: {e}"
-        )))
+    sol.psi().map_err(|source| MicroError::NeedsEquilibrium {
+        what: "parameter derivatives",
+        source,
     })?;
     let p = &problem.pattern;
     let state = &sol.state;

@@ -4,90 +4,69 @@
 //! [ A          0 ] [ λ  ] = [  0 ]
 //!
 //! solved by one sparse Cholesky factorisation of H + μ I (faer, sequential so that results do not depend on
-//! the thread count; the symbolic analysis is kept and reused while the sparsity structure is unchanged) and the
-//! Schur complement S = A (H + μI)⁻¹ Aᵀ of the few dense constraint rows.
+//! the thread count; the lower-triangle pattern is a [`LowerPattern`] and its symbolic analysis is kept and reused
+//! while the sparsity structure is unchanged) and the Schur complement S = A (H + μI)⁻¹ Aᵀ of the few dense
+//! constraint rows.
 
+use crate::sparse::LowerPattern;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::sparse::SparseColMatRef;
 use faer::{Conj, Mat, Par, Side};
 use nalgebra::{DMatrix, DVector};
 
 /// Why a factorisation could not be used.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum FactorError {
     /// H + μI is not numerically positive definite.
+    #[error("the shifted Newton matrix H + μI is not positive definite")]
     NotPositiveDefinite,
     /// The Schur complement of the constraints is singular (dependent constraint rows).
+    #[error("the constraint rows are dependent (singular Schur complement)")]
     SingularConstraints,
-    /// Anything else faer reports (out of memory, index overflow).
+    /// Anything else faer reports (out of memory, index overflow), or a misuse (an entry outside the lower
+    /// triangle, a solve before the matrix is set).
+    #[error("{0}")]
     Other(String),
 }
 
 /// Patterns up to this order keep a dense n×n slot table (4 bytes per entry); larger ones search each column.
 const DENSE_SLOTS_MAX: usize = 3000;
 
-/// The lower-triangle CSC pattern the solver factorises: sorted rows per column, every diagonal entry present.
-/// It only grows within one solver's life, so a matrix whose entries it covers reuses the symbolic analysis.
-struct LowerPattern {
-    n: usize,
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
-    /// value slot of each diagonal entry
-    diag: Vec<usize>,
+/// The lower-triangle pattern the solver factorises ([`LowerPattern`]) with a fast lookup of each entry's value
+/// slot. It only grows within one solver's life, so a matrix whose entries it covers reuses the symbolic
+/// analysis.
+struct SlotPattern {
+    lower: LowerPattern,
     /// slot + 1 of entry (i, j) at i + n j (0: not in the pattern), for n ≤ [`DENSE_SLOTS_MAX`]
     slots: Vec<u32>,
 }
 
-impl LowerPattern {
+impl SlotPattern {
     /// The pattern with the columns `cols` (row lists, unsorted, duplicates allowed) plus the diagonal.
-    fn new(n: usize, mut cols: Vec<Vec<usize>>) -> Self {
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        let mut row_idx = Vec::new();
-        let mut diag = Vec::with_capacity(n);
-        col_ptr.push(0);
-        for (j, rows) in cols.iter_mut().enumerate() {
-            rows.push(j);
-            rows.sort_unstable();
-            rows.dedup();
-            diag.push(row_idx.len() + rows.binary_search(&j).expect("diagonal pushed"));
-            row_idx.extend_from_slice(rows);
-            col_ptr.push(row_idx.len());
-        }
+    fn new(cols: Vec<Vec<usize>>) -> Self {
+        let lower = LowerPattern::from_columns(cols);
+        let n = lower.n;
         let mut slots = Vec::new();
         if n <= DENSE_SLOTS_MAX {
             slots = vec![0u32; n * n];
             for j in 0..n {
-                for s in col_ptr[j]..col_ptr[j + 1] {
-                    slots[row_idx[s] + n * j] = s as u32 + 1;
+                for s in lower.col_ptr[j]..lower.col_ptr[j + 1] {
+                    slots[lower.row_idx[s] + n * j] = s as u32 + 1;
                 }
             }
         }
-        Self {
-            n,
-            col_ptr,
-            row_idx,
-            diag,
-            slots,
-        }
+        Self { lower, slots }
     }
 
     /// The value slot of entry (i, j), if the pattern has it.
     fn slot(&self, i: usize, j: usize) -> Option<usize> {
         if self.slots.is_empty() {
-            let (a, b) = (self.col_ptr[j], self.col_ptr[j + 1]);
-            self.row_idx[a..b].binary_search(&i).ok().map(|k| a + k)
+            self.lower.find(i, j)
         } else {
-            (self.slots[i + self.n * j] as usize).checked_sub(1)
+            (self.slots[i + self.lower.n * j] as usize).checked_sub(1)
         }
-    }
-
-    /// The row lists of the columns.
-    fn columns(&self) -> Vec<Vec<usize>> {
-        (0..self.n)
-            .map(|j| self.row_idx[self.col_ptr[j]..self.col_ptr[j + 1]].to_vec())
-            .collect()
     }
 }
 
@@ -97,7 +76,7 @@ impl LowerPattern {
 /// appear.
 #[derive(Default)]
 pub struct KktSolver {
-    pattern: Option<(LowerPattern, SymbolicCholesky<usize>)>,
+    pattern: Option<(SlotPattern, SymbolicCholesky<usize>)>,
     /// H in the pattern's value order (duplicates summed), without the shift
     matrix: Vec<f64>,
     values: Vec<f64>,
@@ -164,9 +143,9 @@ impl KktSolver {
         // entries the current pattern lacks (all of them when there is none)
         let mut missing: Vec<(usize, usize)> = Vec::new();
         let mut cols = match &self.pattern {
-            Some((p, _)) if p.n == n => {
+            Some((p, _)) if p.lower.n == n => {
                 self.matrix.clear();
-                self.matrix.resize(p.row_idx.len(), 0.0);
+                self.matrix.resize(p.lower.nnz(), 0.0);
                 for &(i, j, v) in lower {
                     match p.slot(i, j) {
                         Some(s) => self.matrix[s] += v,
@@ -176,7 +155,7 @@ impl KktSolver {
                 if missing.is_empty() {
                     return Ok(());
                 }
-                p.columns()
+                p.lower.columns()
             }
             _ => {
                 missing.extend(lower.iter().map(|&(i, j, _)| (i, j)));
@@ -186,16 +165,18 @@ impl KktSolver {
         for (i, j) in missing {
             cols[j].push(i);
         }
-        let pattern = LowerPattern::new(n, cols);
-        let sym =
-            SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
-        let symbolic =
-            factorize_symbolic_cholesky(sym, Side::Lower, Default::default(), Default::default())
-                .map_err(|e| FactorError::Other(format!("{e:?}")))?;
+        let pattern = SlotPattern::new(cols);
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.lower.symbolic(),
+            Side::Lower,
+            Default::default(),
+            Default::default(),
+        )
+        .map_err(|e| FactorError::Other(format!("{e:?}")))?;
         self.analyses += 1;
         self.scratch = None;
         self.matrix.clear();
-        self.matrix.resize(pattern.row_idx.len(), 0.0);
+        self.matrix.resize(pattern.lower.nnz(), 0.0);
         for &(i, j, v) in lower {
             self.matrix[pattern
                 .slot(i, j)
@@ -220,48 +201,114 @@ impl KktSolver {
         let Some((pattern, symbolic)) = self.pattern.as_ref() else {
             return Err(FactorError::Other("solve before set_matrix".into()));
         };
-        let n = pattern.n;
-        let mut shifted = self.matrix.clone();
-        for &s in &pattern.diag {
-            shifted[s] += mu;
+        let lower = &pattern.lower;
+        let cols = rhs_list.len().max(a.len()).max(1);
+        let buf = workspace(&mut self.scratch, symbolic, cols);
+        let llt = factorize_shifted(symbolic, lower, &self.matrix, mu, &mut self.values, buf)?;
+        let mut solver = ConstrainedSolve::new(llt, buf, lower.n, a)?;
+        let mut out = solver.apply(&as_slices(rhs_list));
+        for _ in 0..refine {
+            // residual b + H δ with the unshifted symmetric H (lower triangle stored)
+            let res: Vec<Vec<f64>> = out
+                .iter()
+                .zip(rhs_list)
+                .map(|(d, b)| {
+                    let mut r = b.clone();
+                    lower.add_symmetric_product(&self.matrix, d, &mut r);
+                    r
+                })
+                .collect();
+            let corr = solver.apply(&as_slices(&res));
+            for (d, c) in out.iter_mut().zip(corr) {
+                for (x, y) in d.iter_mut().zip(c) {
+                    *x += y;
+                }
+            }
         }
-        let sym =
-            SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
-        let mat = SparseColMatRef::new(sym, &shifted);
-        self.values.clear();
-        self.values.resize(symbolic.len_val(), 0.0);
-        let par = Par::Seq;
-        let k = rhs_list.len();
+        if out.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(FactorError::NotPositiveDefinite);
+        }
+        Ok(out)
+    }
+}
+
+/// The rows of a list of vectors as slices.
+fn as_slices(rows: &[Vec<f64>]) -> Vec<&[f64]> {
+    rows.iter().map(|r| r.as_slice()).collect()
+}
+
+/// The factorisation and solve workspace for `cols` right-hand sides, allocated when the kept one is smaller.
+fn workspace<'a>(
+    scratch: &'a mut Option<(usize, MemBuffer)>,
+    symbolic: &SymbolicCholesky<usize>,
+    cols: usize,
+) -> &'a mut MemBuffer {
+    if !matches!(scratch, Some((c, _)) if *c >= cols) {
+        let req = symbolic
+            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+            .or(symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq));
+        *scratch = Some((cols, MemBuffer::new(req)));
+    }
+    &mut scratch.as_mut().expect("set above").1
+}
+
+/// The numeric Cholesky factorisation of H + μI (`matrix` holds H in the pattern's value order; `values`
+/// receives the factor), sequential and without dynamic regularisation.
+fn factorize_shifted<'a>(
+    symbolic: &'a SymbolicCholesky<usize>,
+    lower: &LowerPattern,
+    matrix: &[f64],
+    mu: f64,
+    values: &'a mut Vec<f64>,
+    buf: &mut MemBuffer,
+) -> Result<LltRef<'a, usize, f64>, FactorError> {
+    let mut shifted = matrix.to_vec();
+    for &s in &lower.diag {
+        shifted[s] += mu;
+    }
+    let mat = SparseColMatRef::new(lower.symbolic(), &shifted);
+    values.clear();
+    values.resize(symbolic.len_val(), 0.0);
+    symbolic
+        .factorize_numeric_llt(
+            values,
+            mat,
+            Side::Lower,
+            LltRegularization {
+                dynamic_regularization_delta: 0.0,
+                dynamic_regularization_epsilon: 0.0,
+            },
+            Par::Seq,
+            MemStack::new(buf),
+            Default::default(),
+        )
+        .map_err(|_| FactorError::NotPositiveDefinite)
+}
+
+/// Solves with the factorised K = H + μI on the constraint space A δ = 0 by the Schur complement of the
+/// constraint rows: X_A = K⁻¹ Aᵀ, S = A X_A, and for each right-hand side b, δ = −(x + X_A λ) with x = K⁻¹ b and
+/// λ = −S⁻¹ A x.
+struct ConstrainedSolve<'a> {
+    llt: LltRef<'a, usize, f64>,
+    buf: &'a mut MemBuffer,
+    n: usize,
+    a: &'a [Vec<f64>],
+    /// X_A = K⁻¹ Aᵀ (n × m)
+    xa: Mat<f64>,
+    /// S⁻¹ (none without constraint rows)
+    sinv: Option<DMatrix<f64>>,
+}
+
+impl<'a> ConstrainedSolve<'a> {
+    /// X_A and S⁻¹ for the constraint rows `a`; an error when S is singular.
+    fn new(
+        llt: LltRef<'a, usize, f64>,
+        buf: &'a mut MemBuffer,
+        n: usize,
+        a: &'a [Vec<f64>],
+    ) -> Result<Self, FactorError> {
         let m = a.len();
-        let cols = k.max(m).max(1);
-        if !matches!(&self.scratch, Some((c, _)) if *c >= cols) {
-            let req = symbolic
-                .factorize_numeric_llt_scratch::<f64>(par, Default::default())
-                .or(symbolic.solve_in_place_scratch::<f64>(cols, par));
-            self.scratch = Some((cols, MemBuffer::new(req)));
-        }
-        let buf = &mut self.scratch.as_mut().expect("set above").1;
-        let llt: LltRef<'_, usize, f64> = symbolic
-            .factorize_numeric_llt(
-                &mut self.values,
-                mat,
-                Side::Lower,
-                LltRegularization {
-                    dynamic_regularization_delta: 0.0,
-                    dynamic_regularization_epsilon: 0.0,
-                },
-                par,
-                MemStack::new(buf),
-                Default::default(),
-            )
-            .map_err(|_| FactorError::NotPositiveDefinite)?;
-        let mut solve_cols = |cols: &[&[f64]]| -> Mat<f64> {
-            let mut rhs = Mat::<f64>::from_fn(n, cols.len(), |i, j| cols[j][i]);
-            llt.solve_in_place_with_conj(Conj::No, rhs.as_mut(), par, MemStack::new(buf));
-            rhs
-        };
-        // X_A = (H+μI)⁻¹ Aᵀ and the Schur complement S = A X_A
-        let xa = solve_cols(&a.iter().map(|r| r.as_slice()).collect::<Vec<_>>());
+        let xa = solve_columns(&llt, buf, n, &as_slices(a));
         let sinv = if m > 0 {
             let s = DMatrix::from_fn(m, m, |i, j| {
                 (0..n).map(|q| a[i][q] * xa[(q, j)]).sum::<f64>()
@@ -276,61 +323,52 @@ impl KktSolver {
         } else {
             None
         };
-        // δ = −(x + X_A λ), x = (H+μI)⁻¹ b, λ = −S⁻¹ A x
-        let mut apply = |cols: &[&[f64]]| -> Vec<Vec<f64>> {
-            let x = solve_cols(cols);
-            (0..cols.len())
-                .map(|c| {
-                    let mut delta: Vec<f64> = (0..n).map(|i| -x[(i, c)]).collect();
-                    if let Some(sinv) = &sinv {
-                        let ax = DVector::from_fn(m, |i, _| {
-                            (0..n).map(|q| a[i][q] * x[(q, c)]).sum::<f64>()
-                        });
-                        let lambda = -(sinv * ax);
-                        for (i, d) in delta.iter_mut().enumerate() {
-                            let mut t = 0.0;
-                            for q in 0..m {
-                                t += xa[(i, q)] * lambda[q];
-                            }
-                            *d -= t;
-                        }
-                    }
-                    delta
-                })
-                .collect()
-        };
-        let mut out = apply(&rhs_list.iter().map(|r| r.as_slice()).collect::<Vec<_>>());
-        for _ in 0..refine {
-            // residual b + H δ with the unshifted symmetric H (lower triangle stored)
-            let res: Vec<Vec<f64>> = out
-                .iter()
-                .zip(rhs_list)
-                .map(|(d, b)| {
-                    let mut r = b.clone();
-                    for j in 0..n {
-                        for s in pattern.col_ptr[j]..pattern.col_ptr[j + 1] {
-                            let (i, v) = (pattern.row_idx[s], self.matrix[s]);
-                            r[i] += v * d[j];
-                            if i != j {
-                                r[j] += v * d[i];
-                            }
-                        }
-                    }
-                    r
-                })
-                .collect();
-            let corr = apply(&res.iter().map(|r| r.as_slice()).collect::<Vec<_>>());
-            for (d, c) in out.iter_mut().zip(corr) {
-                for (x, y) in d.iter_mut().zip(c) {
-                    *x += y;
-                }
-            }
-        }
-        if out.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(FactorError::NotPositiveDefinite);
-        }
-        Ok(out)
+        Ok(ConstrainedSolve {
+            llt,
+            buf,
+            n,
+            a,
+            xa,
+            sinv,
+        })
     }
+
+    /// δ = −(x + X_A λ), x = K⁻¹ b, λ = −S⁻¹ A x for each column b of `cols`.
+    fn apply(&mut self, cols: &[&[f64]]) -> Vec<Vec<f64>> {
+        let (n, m, a) = (self.n, self.a.len(), self.a);
+        let x = solve_columns(&self.llt, self.buf, n, cols);
+        (0..cols.len())
+            .map(|c| {
+                let mut delta: Vec<f64> = (0..n).map(|i| -x[(i, c)]).collect();
+                if let Some(sinv) = &self.sinv {
+                    let ax = DVector::from_fn(m, |i, _| {
+                        (0..n).map(|q| a[i][q] * x[(q, c)]).sum::<f64>()
+                    });
+                    let lambda = -(sinv * ax);
+                    for (i, d) in delta.iter_mut().enumerate() {
+                        let mut t = 0.0;
+                        for q in 0..m {
+                            t += self.xa[(i, q)] * lambda[q];
+                        }
+                        *d -= t;
+                    }
+                }
+                delta
+            })
+            .collect()
+    }
+}
+
+/// K⁻¹ applied to the columns `cols` (each of length n), as an n × cols matrix.
+fn solve_columns(
+    llt: &LltRef<'_, usize, f64>,
+    buf: &mut MemBuffer,
+    n: usize,
+    cols: &[&[f64]],
+) -> Mat<f64> {
+    let mut rhs = Mat::<f64>::from_fn(n, cols.len(), |i, j| cols[j][i]);
+    llt.solve_in_place_with_conj(Conj::No, rhs.as_mut(), Par::Seq, MemStack::new(buf));
+    rhs
 }
 
 #[cfg(test)]

@@ -11,7 +11,9 @@
 //! The result is a [`Pattern`] like a loaded `.pyp` file (and writable as one).
 
 use super::envelope::energy_strain_gradient;
-use super::solver::{world_positions, MicroError, MicroProblem, MicroState, SolverOptions};
+use super::solver::{
+    world_positions, MicroError, MicroProblem, MicroState, NotConverged, SolverOptions,
+};
 use super::strain::MacroStrain;
 use crate::pattern::Pattern;
 use crate::rod::{set_rest_to_current, YarnMaterial};
@@ -88,27 +90,48 @@ pub struct ReferenceReport {
 }
 
 /// Why the reference computation failed.
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum ReferenceError {
-    Solve(MicroError),
-    NotConverged(String),
+    #[error(transparent)]
+    Solve(#[from] MicroError),
+    /// A micro solve of the computation did not converge; `stage` says which ("stress-free round 3", "in-plane
+    /// minimum at (…)", "final reference state").
+    #[error("{stage}: {source}")]
+    Unconverged { stage: String, source: NotConverged },
+    /// Step 1 did not reach a stress-free state within the allowed rounds.
+    #[error(
+        "no stress-free state after {rounds} rounds: relaxed energy {energy:.3e} J (target {target:.3e} J)"
+    )]
+    NoStressFreeState {
+        rounds: usize,
+        energy: f64,
+        target: f64,
+    },
+    /// Step 3 did not reach zero tile forces within the allowed Newton steps.
+    #[error(
+        "no zero-stress periods after {steps} Newton steps: tile forces {:.3e}, {:.3e} N (target {tolerance:.1e} N)",
+        .force[0],
+        .force[1]
+    )]
+    NoZeroStressPeriods {
+        steps: usize,
+        force: [f64; 2],
+        tolerance: f64,
+    },
+    /// Step 3 found no strain step that lowers the tile forces.
+    #[error(
+        "the zero-stress search stalled at s = ({:.3e}, {:.3e}) with tile forces {:.3e}, {:.3e} N",
+        .s[0],
+        .s[1],
+        .force[0],
+        .force[1]
+    )]
+    PeriodSearchStalled { s: [f64; 2], force: [f64; 2] },
 }
 
-impl std::fmt::Display for ReferenceError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            ReferenceError::Solve(e) => write!(f, "{e}"),
-            ReferenceError::NotConverged(m) => write!(f, "{m}"),
-        }
-    }
-}
-
-impl std::error::Error for ReferenceError {}
-
-impl From<MicroError> for ReferenceError {
-    fn from(e: MicroError) -> Self {
-        ReferenceError::Solve(e)
-    }
+/// The error of a micro solve at `stage` that did not converge.
+fn unconverged(stage: String) -> impl FnOnce(NotConverged) -> ReferenceError {
+    move |source| ReferenceError::Unconverged { stage, source }
 }
 
 /// Write an in-plane equilibrium (s_a = 0, no bending) back into a pattern: world positions become the reference
@@ -144,9 +167,60 @@ pub fn reference_state(
         m.radius = p.radius;
         m.stretch_stiffness()
     };
-    let mean_rest = p.edges.iter().map(|e| e.rest_length).sum::<f64>() / p.len() as f64;
 
     // 1. stress-free state
+    let (rounds, energy) = stress_free(&mut p, material, solver, options, ks)?;
+
+    // 2. tension
+    if options.stress_free_and_tension {
+        tension(&mut p, construction, options);
+    }
+    let periods_in = p.periods;
+
+    // 3. in-plane minimum by Newton on the envelope stress
+    let search = PeriodSearch {
+        problem: MicroProblem::new(p.clone(), material, solver.clone()),
+        periods_in,
+    };
+    let (minimum, period_steps) =
+        search.run(options.stress_tolerance * ks, options.max_period_steps)?;
+    let mut out = pattern_from_state(&p, &minimum.state);
+
+    // 4. centring
+    centre(&mut out);
+
+    // the final state's Ψ̄ at its own zero strain
+    let check = MicroProblem::new(out.clone(), material, solver.clone());
+    let sol = check.solve(&MacroStrain::ZERO, None)?;
+    let psi = sol
+        .psi()
+        .map_err(unconverged("final reference state".into()))?;
+    let report = ReferenceReport {
+        rounds,
+        stress_free_energy: energy,
+        period_strain: minimum.s,
+        period_steps,
+        residual_force: minimum.force,
+        periods_in,
+        periods_out: out.periods,
+        psi,
+        time: t0.elapsed().as_secs_f64(),
+    };
+    Ok((out, report))
+}
+
+/// Step 1, the stress-free state: rounds of { rest values ← current values; relax at zero strain with the
+/// softened material } until the relaxed energy is below 1e-10 · k_s · (mean rest length); the rest values are
+/// then set to the relaxed shape. Returns the rounds and the last relaxed energy (0 and no change when
+/// `options.stress_free_and_tension` is off).
+fn stress_free(
+    p: &mut Pattern,
+    material: &YarnMaterial,
+    solver: &SolverOptions,
+    options: &ReferenceOptions,
+    ks: f64,
+) -> Result<(usize, f64), ReferenceError> {
+    let mean_rest = p.edges.iter().map(|e| e.rest_length).sum::<f64>() / p.len() as f64;
     let mut rounds = 0;
     let mut energy = if options.stress_free_and_tension {
         f64::INFINITY
@@ -158,31 +232,34 @@ pub fn reference_state(
     soft.shear *= options.stress_free_softening;
     while options.stress_free_and_tension && rounds < options.max_rounds {
         rounds += 1;
-        set_rest_to_current(&mut p);
+        set_rest_to_current(p);
         let problem = MicroProblem::new(p.clone(), &soft, solver.clone());
         let sol = problem.solve(&MacroStrain::ZERO, None)?;
-        sol.psi().map_err(|e| {
-            ReferenceError::NotConverged(format!("stress-free round {rounds}: {e}"))
-        })?;
+        sol.psi()
+            .map_err(unconverged(format!("stress-free round {rounds}")))?;
         energy = sol.energy.total();
-        p = pattern_from_state(&p, &sol.state);
+        *p = pattern_from_state(p, &sol.state);
         if energy < 1e-10 * ks * mean_rest {
             break;
         }
     }
     if energy >= 1e-10 * ks * mean_rest {
-        return Err(ReferenceError::NotConverged(format!(
-            "no stress-free state after {rounds} rounds: relaxed energy {energy:.3e} J (target {:.3e} J)",
-            1e-10 * ks * mean_rest
-        )));
+        return Err(ReferenceError::NoStressFreeState {
+            rounds,
+            energy,
+            target: 1e-10 * ks * mean_rest,
+        });
     }
     if options.stress_free_and_tension {
-        set_rest_to_current(&mut p);
+        set_rest_to_current(p);
     }
+    Ok((rounds, energy))
+}
 
-    // 2. tension
+/// Step 2, tension: knitted patterns get rest lengths × `knit_length` and rest curvatures × `knit_curvature`,
+/// woven ones rest curvatures × `woven_curvature`.
+fn tension(p: &mut Pattern, construction: Construction, options: &ReferenceOptions) {
     match construction {
-        _ if !options.stress_free_and_tension => {}
         Construction::Knitted => {
             for e in p.edges.iter_mut() {
                 e.rest_length *= options.knit_length;
@@ -199,85 +276,10 @@ pub fn reference_state(
             }
         }
     }
-    let periods_in = p.periods;
+}
 
-    // 3. in-plane minimum by Newton on the envelope stress
-    let problem = MicroProblem::new(p.clone(), material, solver.clone());
-    let force = |state: &MicroState| -> Result<[f64; 2], MicroError> {
-        let d = energy_strain_gradient(&problem, state)?;
-        Ok([
-            d[0].expect("in-plane family") / periods_in[0],
-            d[2].expect("in-plane family") / periods_in[1],
-        ])
-    };
-    let solve = |s: [f64; 2], warm: Option<&MicroState>| -> Result<MicroState, ReferenceError> {
-        let z = MacroStrain::in_plane(s[0], 0.0, s[1]);
-        let sol = problem.solve(&z, warm)?;
-        sol.psi()
-            .map_err(|e| ReferenceError::NotConverged(format!("in-plane minimum at {z}: {e}")))?;
-        Ok(sol.state)
-    };
-    let mut s = [0.0, 0.0];
-    let mut state = solve(s, None)?;
-    let mut f = force(&state)?;
-    let mut steps = 0;
-    let tol = options.stress_tolerance * ks;
-    while f[0].abs().max(f[1].abs()) > tol {
-        if steps >= options.max_period_steps {
-            return Err(ReferenceError::NotConverged(format!(
-                "no zero-stress periods after {steps} Newton steps: tile forces {:.3e}, {:.3e} N (target {tol:.1e} N)",
-                f[0], f[1]
-            )));
-        }
-        steps += 1;
-        // Jacobian of the tile forces by central differences of warm-started solves
-        let h = 1e-4;
-        let mut jac = nalgebra::Matrix2::zeros();
-        for k in 0..2 {
-            let (mut sp, mut sm) = (s, s);
-            sp[k] += h;
-            sm[k] -= h;
-            let fp = force(&solve(sp, Some(&state))?)?;
-            let fm = force(&solve(sm, Some(&state))?)?;
-            jac[(0, k)] = (fp[0] - fm[0]) / (2.0 * h);
-            jac[(1, k)] = (fp[1] - fm[1]) / (2.0 * h);
-        }
-        let rhs = nalgebra::Vector2::new(-f[0], -f[1]);
-        let mut ds = jac
-            .lu()
-            .solve(&rhs)
-            .unwrap_or_else(|| rhs * (1e-3 / rhs.norm().max(1e-300)));
-        let len = ds.norm();
-        if len > 0.05 {
-            ds *= 0.05 / len;
-        }
-        // accept the step if it lowers the force norm, else halve it
-        let fnorm = (f[0] * f[0] + f[1] * f[1]).sqrt();
-        let mut accepted = false;
-        for _ in 0..20 {
-            let trial = [s[0] + ds[0], s[1] + ds[1]];
-            if let Ok(st) = solve(trial, Some(&state)) {
-                let ft = force(&st)?;
-                if (ft[0] * ft[0] + ft[1] * ft[1]).sqrt() < fnorm {
-                    s = trial;
-                    state = st;
-                    f = ft;
-                    accepted = true;
-                    break;
-                }
-            }
-            ds *= 0.5;
-        }
-        if !accepted {
-            return Err(ReferenceError::NotConverged(format!(
-                "the zero-stress search stalled at s = ({:.3e}, {:.3e}) with tile forces {:.3e}, {:.3e} N",
-                s[0], s[1], f[0], f[1]
-            )));
-        }
-    }
-    let mut out = pattern_from_state(&p, &state);
-
-    // 4. centring
+/// Step 4, centring: the Voronoi-length-weighted mean of the positions moves to the origin.
+fn centre(out: &mut Pattern) {
     let w = out.voronoi_lengths();
     let total: f64 = w.iter().sum();
     let centre: Vector3<f64> = out
@@ -290,23 +292,120 @@ pub fn reference_state(
     for x in out.positions.iter_mut() {
         *x -= centre;
     }
+}
 
-    // the final state's Ψ̄ at its own zero strain
-    let check = MicroProblem::new(out.clone(), material, solver.clone());
-    let sol = check.solve(&MacroStrain::ZERO, None)?;
-    let psi = sol
-        .psi()
-        .map_err(|e| ReferenceError::NotConverged(format!("final reference state: {e}")))?;
-    let report = ReferenceReport {
-        rounds,
-        stress_free_energy: energy,
-        period_strain: s,
-        period_steps: steps,
-        residual_force: f,
-        periods_in,
-        periods_out: out.periods,
-        psi,
-        time: t0.elapsed().as_secs_f64(),
-    };
-    Ok((out, report))
+/// Step 3, the in-plane minimum: strains (s_x, s_y) at s_a = 0 where the tile forces ∂E/∂s_k / p_k (envelope
+/// theorem, p the tensioned pattern's periods) vanish.
+struct PeriodSearch {
+    problem: MicroProblem,
+    periods_in: [f64; 2],
+}
+
+/// An equilibrium of the zero-stress search: its strains (s_x, s_y), state and tile forces (N).
+struct Equilibrium {
+    s: [f64; 2],
+    state: MicroState,
+    force: [f64; 2],
+}
+
+impl PeriodSearch {
+    /// The tile forces ∂E/∂s_x / p₁, ∂E/∂s_y / p₂ (N) at an in-plane equilibrium.
+    fn force(&self, state: &MicroState) -> Result<[f64; 2], MicroError> {
+        let d = energy_strain_gradient(&self.problem, state)?;
+        Ok([
+            d[0].expect("in-plane family") / self.periods_in[0],
+            d[2].expect("in-plane family") / self.periods_in[1],
+        ])
+    }
+
+    /// The converged equilibrium at (s_x, 0, s_y), warm-started from `warm` when given.
+    fn solve(&self, s: [f64; 2], warm: Option<&MicroState>) -> Result<MicroState, ReferenceError> {
+        let z = MacroStrain::in_plane(s[0], 0.0, s[1]);
+        let sol = self.problem.solve(&z, warm)?;
+        sol.psi()
+            .map_err(unconverged(format!("in-plane minimum at {z}")))?;
+        Ok(sol.state)
+    }
+
+    /// Newton's method on the forces from s = 0 until both are within `tol` (N), at most `max_steps` steps:
+    /// the equilibrium found and the steps taken.
+    fn run(&self, tol: f64, max_steps: usize) -> Result<(Equilibrium, usize), ReferenceError> {
+        let s = [0.0, 0.0];
+        let state = self.solve(s, None)?;
+        let force = self.force(&state)?;
+        let mut at = Equilibrium { s, state, force };
+        let mut steps = 0;
+        while at.force[0].abs().max(at.force[1].abs()) > tol {
+            if steps >= max_steps {
+                return Err(ReferenceError::NoZeroStressPeriods {
+                    steps,
+                    force: at.force,
+                    tolerance: tol,
+                });
+            }
+            steps += 1;
+            let ds = self.newton_step(&at)?;
+            let Some(next) = self.backtrack(&at, ds)? else {
+                return Err(ReferenceError::PeriodSearchStalled {
+                    s: at.s,
+                    force: at.force,
+                });
+            };
+            at = next;
+        }
+        Ok((at, steps))
+    }
+
+    /// The Newton step −J⁻¹ f at `at`, its Jacobian J by central differences (h = 1e-4) of solves warm-started
+    /// from `at`, the step length limited to 0.05 (a small step along −f when J is singular).
+    fn newton_step(&self, at: &Equilibrium) -> Result<nalgebra::Vector2<f64>, ReferenceError> {
+        let (s, f) = (at.s, at.force);
+        let h = 1e-4;
+        let mut jac = nalgebra::Matrix2::zeros();
+        for k in 0..2 {
+            let (mut sp, mut sm) = (s, s);
+            sp[k] += h;
+            sm[k] -= h;
+            let fp = self.force(&self.solve(sp, Some(&at.state))?)?;
+            let fm = self.force(&self.solve(sm, Some(&at.state))?)?;
+            jac[(0, k)] = (fp[0] - fm[0]) / (2.0 * h);
+            jac[(1, k)] = (fp[1] - fm[1]) / (2.0 * h);
+        }
+        let rhs = nalgebra::Vector2::new(-f[0], -f[1]);
+        let mut ds = jac
+            .lu()
+            .solve(&rhs)
+            .unwrap_or_else(|| rhs * (1e-3 / rhs.norm().max(1e-300)));
+        let len = ds.norm();
+        if len > 0.05 {
+            ds *= 0.05 / len;
+        }
+        Ok(ds)
+    }
+
+    /// The first of s + ds, s + ds/2, … (20 trials) whose solve converges with a smaller force norm than at
+    /// `at`; `None` when none does.
+    fn backtrack(
+        &self,
+        at: &Equilibrium,
+        mut ds: nalgebra::Vector2<f64>,
+    ) -> Result<Option<Equilibrium>, ReferenceError> {
+        let (s, f) = (at.s, at.force);
+        let fnorm = (f[0] * f[0] + f[1] * f[1]).sqrt();
+        for _ in 0..20 {
+            let trial = [s[0] + ds[0], s[1] + ds[1]];
+            if let Ok(st) = self.solve(trial, Some(&at.state)) {
+                let ft = self.force(&st)?;
+                if (ft[0] * ft[0] + ft[1] * ft[1]).sqrt() < fnorm {
+                    return Ok(Some(Equilibrium {
+                        s: trial,
+                        state: st,
+                        force: ft,
+                    }));
+                }
+            }
+            ds *= 0.5;
+        }
+        Ok(None)
+    }
 }

@@ -20,7 +20,7 @@ use super::strain::{Family, MacroStrain, StrainError};
 use crate::contact::ContactError;
 use crate::pattern::Pattern;
 use crate::rod::{RodState, RodTopology, YarnMaterial};
-use crate::tile::{EnergyParts, Terms, Tile, Want};
+use crate::tile::{EnergyParts, Terms, Tile, TileEval, Want};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -49,7 +49,8 @@ pub struct SolverOptions {
     pub backtracking: f64,
     /// Broad-phase margin in units of r.
     pub contact_margin: f64,
-    /// Print one line per Newton step to stderr (energy, ‖g‖∞, decrement, μ, step length).
+    /// Emit one `tracing` event (info level) per Newton step: energy, ‖g‖∞, decrement, μ, step length (`hylc
+    /// solve --trace` prints them to stderr).
     pub trace: bool,
 }
 
@@ -89,35 +90,30 @@ impl fmt::Display for Status {
 }
 
 /// Errors that stop a solve before it runs or in the middle (bad input, overlapping yarns at the start).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MicroError {
-    Strain(StrainError),
-    Contact(ContactError),
-    Linear(FactorError),
-}
-
-impl fmt::Display for MicroError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            MicroError::Strain(e) => write!(f, "{e}"),
-            MicroError::Contact(e) => write!(f, "contact: {e}"),
-            MicroError::Linear(e) => write!(f, "linear solve: {e:?}"),
-        }
-    }
-}
-
-impl std::error::Error for MicroError {}
-
-impl From<StrainError> for MicroError {
-    fn from(e: StrainError) -> Self {
-        MicroError::Strain(e)
-    }
-}
-
-impl From<ContactError> for MicroError {
-    fn from(e: ContactError) -> Self {
-        MicroError::Contact(e)
-    }
+    #[error(transparent)]
+    Strain(#[from] StrainError),
+    #[error("contact: {0}")]
+    Contact(#[from] ContactError),
+    #[error("linear solve: {0}")]
+    Linear(#[from] FactorError),
+    /// A quantity defined at an equilibrium asked of a solve that did not converge.
+    #[error("{what} need an equilibrium: {source}")]
+    NeedsEquilibrium {
+        what: &'static str,
+        source: NotConverged,
+    },
+    /// A constraint row of [`MicroProblem::with_constraints`] with the wrong number of entries.
+    #[error("constraint row {row} has {len} entries, expected {expected}")]
+    ConstraintLength {
+        row: usize,
+        len: usize,
+        expected: usize,
+    },
+    /// A constraint row of [`MicroProblem::with_constraints`] that cannot be normalised.
+    #[error("constraint row {row} is zero or not finite")]
+    ConstraintRow { row: usize },
 }
 
 /// A yarn state at a macro strain: the unknowns y = (ũ, θ) in the tile's dof layout and the stored frames
@@ -166,24 +162,15 @@ pub struct Solution {
 }
 
 /// Asking for Ψ̄ of a non-converged solve.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error(
+    "the micro solve did not converge ({status} after {steps} steps, ‖g‖∞ = {gradient_norm:.3e} N)"
+)]
 pub struct NotConverged {
     pub status: Status,
     pub steps: usize,
     pub gradient_norm: f64,
 }
-
-impl fmt::Display for NotConverged {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "the micro solve did not converge ({} after {} steps, ‖g‖∞ = {:.3e} N)",
-            self.status, self.steps, self.gradient_norm
-        )
-    }
-}
-
-impl std::error::Error for NotConverged {}
 
 impl Solution {
     /// Ψ̄ = E / (p₁ p₂) (J/m²) of a converged solve; an error for any other status.
@@ -234,19 +221,20 @@ impl MicroProblem {
     /// Replace the constraint rows (each of length 4n over the unknowns y = (ũ, θ); normalised here), e.g. to pin
     /// one vertex per yarn along its axis as the original solver did. The rows must be independent and, together
     /// with H, leave no free rigid mode.
-    pub fn with_constraints(mut self, rows: Vec<Vec<f64>>) -> Result<Self, String> {
+    pub fn with_constraints(mut self, rows: Vec<Vec<f64>>) -> Result<Self, MicroError> {
         let nd = 4 * self.pattern.len();
         let mut rows = rows;
         for (k, row) in rows.iter_mut().enumerate() {
             if row.len() != nd {
-                return Err(format!(
-                    "constraint row {k} has {} entries, expected {nd}",
-                    row.len()
-                ));
+                return Err(MicroError::ConstraintLength {
+                    row: k,
+                    len: row.len(),
+                    expected: nd,
+                });
             }
             let norm = row.iter().map(|v| v * v).sum::<f64>().sqrt();
             if !(norm.is_finite() && norm > 0.0) {
-                return Err(format!("constraint row {k} is zero or not finite"));
+                return Err(MicroError::ConstraintRow { row: k });
             }
             row.iter_mut().for_each(|v| *v /= norm);
         }
@@ -458,208 +446,310 @@ impl MicroProblem {
         Ok(sol)
     }
 
-    /// Newton iterations from a state already at its strain.
+    /// Newton iterations from a state already at its strain (the steps of the module documentation).
     fn newton(&self, mut state: MicroState, t0: Instant) -> Result<Solution, MicroError> {
         let opts = &self.options;
-        let n = self.pattern.len();
-        let nd = 4 * n;
-        let r = self.pattern.radius;
-        let ks = self.material.stretch_stiffness();
-        let elim = Elimination::in_family(&self.pattern, &state.strain, state.family);
-        let mut tile = self.tile(&elim);
+        let mut run = NewtonRun::start(self, &state, t0)?;
+        loop {
+            // 1. energy, scaled gradient and Hessian at the iterate
+            let ta = Instant::now();
+            let ev = run
+                .tile
+                .evaluate(&state.frames, &state.y, Want::Hessian, &Terms::ALL)?;
+            run.timings.assembly += ta.elapsed().as_secs_f64();
+            let energy = ev.value();
+            let g = run.scaled_gradient(&ev);
+            // 2. the force test uses the gradient projected on the constraint space (the constrained equilibrium
+            // keeps a residual g = −Aᵀλ along the rows that are not exact symmetries, e.g. the yarn slides)
+            let gnorm = self.project(&g).iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            if let Some(status) = run.stop_before_step(gnorm) {
+                return Ok(run.finish(state, status, &ev, gnorm));
+            }
+            // 3. KKT step
+            let Some(mut delta) = run.direction(&ev, &g)? else {
+                return Ok(run.finish(state, Status::Stalled, &ev, gnorm));
+            };
+            let decrement: f64 = g.iter().zip(&delta).map(|(a, b)| a * b).sum();
+            if decrement.abs() <= opts.decrement_tolerance * (energy.abs() + run.ks * run.r) {
+                return Ok(run.finish(state, Status::Converged, &ev, gnorm));
+            }
+            // 4. back to tile dofs, displacement limit
+            let dmax_now = run.limit_step(&mut delta);
+            // 5. line search
+            let accepted = run.line_search(&mut state, &delta, energy);
+            if opts.trace {
+                tracing::info!(
+                    "step {}: E {energy:.15e} J, |g|inf {gnorm:.3e} N, g.d {decrement:.3e} J, mu {:.2e}, \
+                     |d|max {:.3e} m, accepted {}, symbolic analyses {}",
+                    run.steps,
+                    run.mu,
+                    dmax_now.min(run.d_max),
+                    match accepted {
+                        Some(step) => format!("at {step:.0e}"),
+                        None => "none".into(),
+                    },
+                    run.kkt.analyses
+                );
+            }
+            run.steps += 1;
+            if accepted.is_none() {
+                // no lower energy: converged only at round-off level
+                let status = if decrement.abs() <= 1e-11 * (energy.abs() + run.ks * run.r) {
+                    Status::Converged
+                } else {
+                    Status::Stalled
+                };
+                return Ok(run.finish(state, status, &ev, gnorm));
+            }
+            run.mu = (run.mu / 10.0).max(run.mu_floor);
+        }
+    }
+}
+
+/// The working state of one Newton solve ([`MicroProblem::newton`]): the tile with its contact candidates, the
+/// KKT solver with its kept symbolic analysis, the regularisation μ and the bookkeeping.
+struct NewtonRun<'p> {
+    problem: &'p MicroProblem,
+    tile: Tile<'p>,
+    /// Home positions at the last contact update.
+    contact_at: Vec<Vector3<f64>>,
+    /// The rod stencils' part of the KKT pattern, added to the first matrix.
+    rod_structure: Vec<(usize, usize, f64)>,
+    kkt: KktSolver,
+    timings: Timings,
+    /// Regularisation μ, its floor at the current step and the largest μ used.
+    mu: f64,
+    mu_floor: f64,
+    max_mu: f64,
+    /// Newton steps taken.
+    steps: usize,
+    n: usize,
+    /// Yarn radius r, stretch stiffness k_s, broad-phase margin, displacement limit d_max, tile area p₁ p₂.
+    r: f64,
+    ks: f64,
+    margin: f64,
+    d_max: f64,
+    area: f64,
+    t0: Instant,
+}
+
+impl<'p> NewtonRun<'p> {
+    /// The tile of `state`'s strain with its contact candidates found, and the fixed part of the KKT pattern.
+    fn start(
+        problem: &'p MicroProblem,
+        state: &MicroState,
+        t0: Instant,
+    ) -> Result<Self, MicroError> {
+        let opts = &problem.options;
+        let r = problem.pattern.radius;
+        let elim = Elimination::in_family(&problem.pattern, &state.strain, state.family);
+        let mut tile = problem.tile(&elim);
         let margin = opts.contact_margin * r;
         let mut timings = Timings::default();
 
         let tc = Instant::now();
-        let mut contact_at = tile.home_positions(&state.y);
+        let contact_at = tile.home_positions(&state.y);
         tile.update_contacts(&contact_at, margin)?;
         // the KKT solver's pattern is the union of every matrix of this solve: the rod blocks from the start,
         // each contact pair's blocks from the first step it is active, so the symbolic analysis is reused
         let rod_structure = rod_structure(&tile);
         timings.contact += tc.elapsed().as_secs_f64();
 
-        // unit scaling M: the angular unknown is r θ
-        let scale = |i: usize| if i < 3 * n { 1.0 } else { 1.0 / r };
-        let d_max = opts.step_factor * r * state.strain.min_stretch_eigenvalue();
-        let mut kkt = KktSolver::default();
-        let mut mu: f64 = 0.0;
-        let mut max_mu: f64 = 0.0;
-        let mut steps = 0;
-        let area = self.pattern.periods[0] * self.pattern.periods[1];
+        Ok(NewtonRun {
+            problem,
+            tile,
+            contact_at,
+            rod_structure,
+            kkt: KktSolver::default(),
+            timings,
+            mu: 0.0,
+            mu_floor: 0.0,
+            max_mu: 0.0,
+            steps: 0,
+            n: problem.pattern.len(),
+            r,
+            ks: problem.material.stretch_stiffness(),
+            margin,
+            d_max: opts.step_factor * r * state.strain.min_stretch_eigenvalue(),
+            area: problem.pattern.periods[0] * problem.pattern.periods[1],
+            t0,
+        })
+    }
 
-        loop {
-            let ta = Instant::now();
-            let ev = tile.evaluate(&state.frames, &state.y, Want::Hessian, &Terms::ALL)?;
-            timings.assembly += ta.elapsed().as_secs_f64();
-            let energy = ev.value();
-            let g: Vec<f64> = ev
-                .gradient
-                .as_ref()
-                .expect("asked for")
-                .iter()
-                .enumerate()
-                .map(|(i, v)| v * scale(i))
-                .collect();
-            // the force test uses the gradient projected on the constraint space (the constrained equilibrium
-            // keeps a residual g = −Aᵀλ along the rows that are not exact symmetries, e.g. the yarn slides)
-            let gnorm = self.project(&g).iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let finish =
-                |state: MicroState, status: Status, steps: usize, timings: Timings, max_mu: f64| {
-                    Solution {
-                        state,
-                        status,
-                        steps,
-                        energy: ev.parts,
-                        gradient_norm: gnorm,
-                        time: t0.elapsed().as_secs_f64(),
-                        timings,
-                        area,
-                        max_mu,
-                    }
-                };
-            if gnorm <= opts.tolerance * ks {
-                return Ok(finish(state, Status::Converged, steps, timings, max_mu));
-            }
-            if steps >= opts.max_steps {
-                return Ok(finish(state, Status::MaxSteps, steps, timings, max_mu));
-            }
-            if let Some(limit) = opts.time_limit {
-                if t0.elapsed().as_secs_f64() > limit {
-                    return Ok(finish(state, Status::TimeLimit, steps, timings, max_mu));
-                }
-            }
+    /// The unit scaling M of dof i: the angular unknown is r θ.
+    fn scale(&self, i: usize) -> f64 {
+        if i < 3 * self.n {
+            1.0
+        } else {
+            1.0 / self.r
+        }
+    }
 
-            // KKT step, growing μ until H + μI factorises
-            let tf = Instant::now();
-            let mut lower: Vec<(usize, usize, f64)> = ev
-                .hessian
-                .as_ref()
-                .expect("asked for")
-                .iter()
-                .filter(|&&(i, j, _)| i >= j)
-                .map(|&(i, j, v)| (i, j, v * scale(i) * scale(j)))
-                .collect();
-            if steps == 0 {
-                lower.extend_from_slice(&rod_structure);
-            }
-            let diag_max = lower
-                .iter()
-                .filter(|t| t.0 == t.1)
-                .fold(0.0f64, |m, t| m.max(t.2.abs()))
-                .max(ks / r);
-            // The tile's rigid motions make H exactly singular: a factorisation at μ = 0 "succeeds" with pivots at
-            // round-off level and returns noise. μ therefore never drops below 1e-10 of the largest diagonal
-            // entry (the constraints remove those modes from the step), and at that floor two steps of iterative
-            // refinement against the unshifted H make the step an exact Newton step also along soft modes. A
-            // step that is not a descent direction counts as a failed factorisation.
-            let mu_floor = 1e-10 * diag_max;
-            mu = mu.max(mu_floor);
-            let mut delta = None;
-            kkt.set_matrix(nd, &lower).map_err(MicroError::Linear)?;
-            for _ in 0..40 {
-                // at the floor, two refinement steps remove the shift's effect on soft modes (exact Newton)
-                let refine = if mu <= mu_floor { 2 } else { 0 };
-                let solved = kkt
-                    .solve_shifted(mu, std::slice::from_ref(&g), &self.constraints, refine)
-                    .map(|mut v| v.pop().expect("one right-hand side"));
-                match solved {
-                    Ok(d) if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 => {
-                        delta = Some(d);
-                        break;
-                    }
-                    Ok(_) | Err(FactorError::NotPositiveDefinite) => {
-                        mu *= 10.0;
-                    }
-                    Err(e) => return Err(MicroError::Linear(e)),
-                }
-            }
-            timings.factorization += tf.elapsed().as_secs_f64();
-            max_mu = max_mu.max(mu);
-            let Some(mut delta) = delta else {
-                return Ok(finish(state, Status::Stalled, steps, timings, max_mu));
-            };
-            let decrement: f64 = g.iter().zip(&delta).map(|(a, b)| a * b).sum();
-            if decrement.abs() <= opts.decrement_tolerance * (energy.abs() + ks * r) {
-                return Ok(finish(state, Status::Converged, steps, timings, max_mu));
-            }
-            // back to tile dofs (θ = y_θ / r), then the displacement limit
-            for (i, d) in delta.iter_mut().enumerate() {
-                *d *= scale(i);
-            }
-            let dmax_now = (0..n)
-                .map(|v| Vector3::new(delta[3 * v], delta[3 * v + 1], delta[3 * v + 2]).norm())
-                .fold(0.0, f64::max);
-            if dmax_now > d_max {
-                let f = d_max / dmax_now;
-                delta.iter_mut().for_each(|d| *d *= f);
-            }
+    /// M⁻¹ ∇E: the gradient in the scaled unknowns.
+    fn scaled_gradient(&self, ev: &TileEval) -> Vec<f64> {
+        ev.gradient
+            .as_ref()
+            .expect("asked for")
+            .iter()
+            .enumerate()
+            .map(|(i, v)| v * self.scale(i))
+            .collect()
+    }
 
-            // backtracking line search on the energy
-            let tl = Instant::now();
-            let mut accepted = false;
-            let mut step = 1.0;
-            let factor = opts.backtracking;
-            let trials = (1e-10f64.ln() / factor.ln()).ceil() as usize;
-            for _ in 0..=trials {
-                let trial: Vec<f64> = state
-                    .y
-                    .iter()
-                    .zip(&delta)
-                    .map(|(a, b)| a + step * b)
-                    .collect();
-                let positions = tile.home_positions(&trial);
-                let moved = positions
-                    .iter()
-                    .zip(&contact_at)
-                    .map(|(a, b)| (a - b).norm())
-                    .fold(0.0, f64::max);
-                if moved > 0.5 * margin {
-                    let tc = Instant::now();
-                    if tile.update_contacts(&positions, margin).is_ok() {
-                        contact_at = positions.clone();
-                    }
-                    timings.contact += tc.elapsed().as_secs_f64();
-                }
-                let e = tile
-                    .evaluate(&state.frames, &trial, Want::Value, &Terms::ALL)
-                    .map(|r| r.value())
-                    .unwrap_or(f64::INFINITY);
-                if e < energy {
-                    let theta = trial[3 * n..].to_vec();
-                    state.frames.advance(
-                        &self.pattern,
-                        &self.topology,
-                        positions,
-                        theta,
-                        &tile.placement,
-                    );
-                    state.y = trial;
-                    accepted = true;
+    /// The status that ends the solve before another step: the force test, the step limit, the time limit.
+    fn stop_before_step(&self, gnorm: f64) -> Option<Status> {
+        let opts = &self.problem.options;
+        if gnorm <= opts.tolerance * self.ks {
+            return Some(Status::Converged);
+        }
+        if self.steps >= opts.max_steps {
+            return Some(Status::MaxSteps);
+        }
+        if let Some(limit) = opts.time_limit {
+            if self.t0.elapsed().as_secs_f64() > limit {
+                return Some(Status::TimeLimit);
+            }
+        }
+        None
+    }
+
+    /// The KKT step in the scaled unknowns, growing μ until H + μI factorises and the step is a descent
+    /// direction; `None` when 40 attempts fail.
+    fn direction(&mut self, ev: &TileEval, g: &[f64]) -> Result<Option<Vec<f64>>, MicroError> {
+        let tf = Instant::now();
+        let mut lower: Vec<(usize, usize, f64)> = ev
+            .hessian
+            .as_ref()
+            .expect("asked for")
+            .iter()
+            .filter(|&&(i, j, _)| i >= j)
+            .map(|&(i, j, v)| (i, j, v * self.scale(i) * self.scale(j)))
+            .collect();
+        if self.steps == 0 {
+            lower.extend_from_slice(&self.rod_structure);
+        }
+        let diag_max = lower
+            .iter()
+            .filter(|t| t.0 == t.1)
+            .fold(0.0f64, |m, t| m.max(t.2.abs()))
+            .max(self.ks / self.r);
+        // The tile's rigid motions make H exactly singular: a factorisation at μ = 0 "succeeds" with pivots at
+        // round-off level and returns noise. μ therefore never drops below 1e-10 of the largest diagonal
+        // entry (the constraints remove those modes from the step), and at that floor two steps of iterative
+        // refinement against the unshifted H make the step an exact Newton step also along soft modes. A
+        // step that is not a descent direction counts as a failed factorisation.
+        self.mu_floor = 1e-10 * diag_max;
+        self.mu = self.mu.max(self.mu_floor);
+        let mut delta = None;
+        self.kkt
+            .set_matrix(4 * self.n, &lower)
+            .map_err(MicroError::Linear)?;
+        let rhs = [g.to_vec()];
+        for _ in 0..40 {
+            // at the floor, two refinement steps remove the shift's effect on soft modes (exact Newton)
+            let refine = if self.mu <= self.mu_floor { 2 } else { 0 };
+            let solved = self
+                .kkt
+                .solve_shifted(self.mu, &rhs, &self.problem.constraints, refine)
+                .map(|mut v| v.pop().expect("one right-hand side"));
+            match solved {
+                Ok(d) if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 => {
+                    delta = Some(d);
                     break;
                 }
-                step *= factor;
+                Ok(_) | Err(FactorError::NotPositiveDefinite) => {
+                    self.mu *= 10.0;
+                }
+                Err(e) => return Err(MicroError::Linear(e)),
             }
-            timings.line_search += tl.elapsed().as_secs_f64();
-            if opts.trace {
-                eprintln!(
-                    "step {steps}: E {energy:.15e} J, |g|inf {gnorm:.3e} N, g.d {decrement:.3e} J, mu {mu:.2e}, \
-                     |d|max {:.3e} m, accepted {}, symbolic analyses {}",
-                    dmax_now.min(d_max),
-                    if accepted { format!("at {step:.0e}") } else { "none".into() },
-                    kkt.analyses
+        }
+        self.timings.factorization += tf.elapsed().as_secs_f64();
+        self.max_mu = self.max_mu.max(self.mu);
+        Ok(delta)
+    }
+
+    /// Back to tile dofs (θ = y_θ / r), then the displacement limit: scale the step so that no vertex moves by
+    /// more than d_max. Returns the largest vertex displacement before the limit.
+    fn limit_step(&self, delta: &mut [f64]) -> f64 {
+        for (i, d) in delta.iter_mut().enumerate() {
+            *d *= self.scale(i);
+        }
+        let dmax_now = (0..self.n)
+            .map(|v| Vector3::new(delta[3 * v], delta[3 * v + 1], delta[3 * v + 2]).norm())
+            .fold(0.0, f64::max);
+        if dmax_now > self.d_max {
+            let f = self.d_max / dmax_now;
+            delta.iter_mut().for_each(|d| *d *= f);
+        }
+        dmax_now
+    }
+
+    /// Backtracking line search on the energy along `delta` (tile dofs) from `state`: trial steps factorⁱ, the
+    /// contact candidates refreshed when the vertices have moved by more than half the margin, the stored frames
+    /// transported to the first trial with a lower energy, which becomes the state. Returns the accepted step.
+    fn line_search(&mut self, state: &mut MicroState, delta: &[f64], energy: f64) -> Option<f64> {
+        let problem = self.problem;
+        let tl = Instant::now();
+        let mut accepted = None;
+        let mut step = 1.0;
+        let factor = problem.options.backtracking;
+        let trials = (1e-10f64.ln() / factor.ln()).ceil() as usize;
+        for _ in 0..=trials {
+            let trial: Vec<f64> = state
+                .y
+                .iter()
+                .zip(delta)
+                .map(|(a, b)| a + step * b)
+                .collect();
+            let positions = self.tile.home_positions(&trial);
+            let moved = positions
+                .iter()
+                .zip(&self.contact_at)
+                .map(|(a, b)| (a - b).norm())
+                .fold(0.0, f64::max);
+            if moved > 0.5 * self.margin {
+                let tc = Instant::now();
+                if self.tile.update_contacts(&positions, self.margin).is_ok() {
+                    self.contact_at = positions.clone();
+                }
+                self.timings.contact += tc.elapsed().as_secs_f64();
+            }
+            let e = self
+                .tile
+                .evaluate(&state.frames, &trial, Want::Value, &Terms::ALL)
+                .map(|r| r.value())
+                .unwrap_or(f64::INFINITY);
+            if e < energy {
+                let theta = trial[3 * self.n..].to_vec();
+                state.frames.advance(
+                    &problem.pattern,
+                    &problem.topology,
+                    positions,
+                    theta,
+                    &self.tile.placement,
                 );
+                state.y = trial;
+                accepted = Some(step);
+                break;
             }
-            steps += 1;
-            if !accepted {
-                // no lower energy: converged only at round-off level
-                let status = if decrement.abs() <= 1e-11 * (energy.abs() + ks * r) {
-                    Status::Converged
-                } else {
-                    Status::Stalled
-                };
-                return Ok(finish(state, status, steps, timings, max_mu));
-            }
-            mu = (mu / 10.0).max(mu_floor);
+            step *= factor;
+        }
+        self.timings.line_search += tl.elapsed().as_secs_f64();
+        accepted
+    }
+
+    /// The solution at `state` with the evaluation `ev` of it.
+    fn finish(&self, state: MicroState, status: Status, ev: &TileEval, gnorm: f64) -> Solution {
+        Solution {
+            state,
+            status,
+            steps: self.steps,
+            energy: ev.parts,
+            gradient_norm: gnorm,
+            time: self.t0.elapsed().as_secs_f64(),
+            timings: self.timings,
+            area: self.area,
+            max_mu: self.max_mu,
         }
     }
 }

@@ -22,19 +22,12 @@ pub enum Family {
 }
 
 /// A strain outside the set the micro solver supports.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("strain {strain}: {message}")]
 pub struct StrainError {
     pub strain: MacroStrain,
     pub message: String,
 }
-
-impl fmt::Display for StrainError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "strain {}: {}", self.strain, self.message)
-    }
-}
-
-impl std::error::Error for StrainError {}
 
 impl fmt::Display for MacroStrain {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

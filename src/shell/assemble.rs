@@ -10,6 +10,7 @@
 use super::element::ElementModel;
 use super::mesh::Stencil;
 use super::strain::NDOF;
+use crate::sparse::LowerPattern;
 use rayon::prelude::*;
 
 const NONE: u32 = u32::MAX;
@@ -23,10 +24,8 @@ pub struct Pattern {
     pub free: Vec<Option<usize>>,
     /// number of free vertices (the system has 3 × this many unknowns)
     pub nfree: usize,
-    pub col_ptr: Vec<usize>,
-    pub row_idx: Vec<usize>,
-    /// value index of each free dof's diagonal entry
-    pub diag: Vec<usize>,
+    /// the lower triangle of the 3 nfree × 3 nfree Hessian (free dof 3k + c of free vertex k)
+    pub lower: LowerPattern,
     /// per stencil, per (local vertex a, local vertex b, column c): value index of the first row stored
     offs: Vec<[u32; 108]>,
 }
@@ -42,40 +41,8 @@ impl Pattern {
                 nfree += 1;
             }
         }
-        // neighbours (free index ≥ own) of every free vertex, including itself
-        let mut nb: Vec<Vec<usize>> = (0..nfree).map(|k| vec![k]).collect();
-        for s in stencils {
-            let live = live_vertices(s);
-            for &a in &live {
-                for &b in &live {
-                    if let (Some(ka), Some(kb)) = (free[s.v[a]], free[s.v[b]]) {
-                        if ka > kb {
-                            nb[kb].push(ka);
-                        }
-                    }
-                }
-            }
-        }
-        for l in nb.iter_mut() {
-            l.sort_unstable();
-            l.dedup();
-        }
-        let mut col_ptr = Vec::with_capacity(3 * nfree + 1);
-        let mut row_idx = Vec::new();
-        let mut diag = Vec::with_capacity(3 * nfree);
-        col_ptr.push(0);
-        for (kb, l) in nb.iter().enumerate() {
-            for c in 0..3 {
-                diag.push(row_idx.len());
-                for &ka in l {
-                    let r0 = if ka == kb { c } else { 0 };
-                    for r in r0..3 {
-                        row_idx.push(3 * ka + r);
-                    }
-                }
-                col_ptr.push(row_idx.len());
-            }
-        }
+        let lower =
+            LowerPattern::from_columns(dof_columns(&block_neighbours(stencils, &free, nfree)));
         let offs = stencils
             .iter()
             .map(|s| {
@@ -91,16 +58,14 @@ impl Pattern {
                         if ka < kb {
                             continue;
                         }
-                        let pos = nb[kb]
-                            .binary_search(&ka)
-                            .expect("pattern holds every stencil pair");
+                        // the first stored row of block (ka, kb) in column 3 kb + c: 3 ka + c on the diagonal
+                        // block (its lower triangle), else 3 ka
                         for c in 0..3 {
-                            let start = col_ptr[3 * kb + c];
-                            o[18 * a + 3 * b + c] = if ka == kb {
-                                start as u32
-                            } else {
-                                (start + (3 - c) + 3 * (pos - 1)) as u32
-                            };
+                            let r0 = if ka == kb { c } else { 0 };
+                            o[18 * a + 3 * b + c] = lower
+                                .find(3 * ka + r0, 3 * kb + c)
+                                .expect("pattern holds every stencil pair")
+                                as u32;
                         }
                     }
                 }
@@ -111,27 +76,64 @@ impl Pattern {
             n,
             free,
             nfree,
-            col_ptr,
-            row_idx,
-            diag,
+            lower,
             offs,
         }
     }
 
     /// Number of stored (lower-triangle) entries.
     pub fn nnz(&self) -> usize {
-        self.row_idx.len()
+        self.lower.nnz()
     }
 
     /// Add a symmetric 3×3 block to the diagonal block of free vertex `k`.
     pub fn add_diag_block(&self, values: &mut [f64], k: usize, m: &[[f64; 3]; 3]) {
         for c in 0..3 {
-            let start = self.diag[3 * k + c];
+            let start = self.lower.diag[3 * k + c];
             for r in c..3 {
                 values[start + r - c] += m[r][c];
             }
         }
     }
+}
+
+/// The free vertices ≥ k that share a stencil with free vertex k (k itself included), sorted, for every k.
+fn block_neighbours(stencils: &[Stencil], free: &[Option<usize>], nfree: usize) -> Vec<Vec<usize>> {
+    let mut nb: Vec<Vec<usize>> = (0..nfree).map(|k| vec![k]).collect();
+    for s in stencils {
+        let live = live_vertices(s);
+        for &a in &live {
+            for &b in &live {
+                if let (Some(ka), Some(kb)) = (free[s.v[a]], free[s.v[b]]) {
+                    if ka > kb {
+                        nb[kb].push(ka);
+                    }
+                }
+            }
+        }
+    }
+    for l in nb.iter_mut() {
+        l.sort_unstable();
+        l.dedup();
+    }
+    nb
+}
+
+/// The dof rows of every dof column from the block neighbours: column 3 kb + c holds the lower triangle of the
+/// diagonal block (rows 3 kb + c … 3 kb + 2) and the three rows of every block (ka, kb) below it.
+fn dof_columns(nb: &[Vec<usize>]) -> Vec<Vec<usize>> {
+    let mut cols = Vec::with_capacity(3 * nb.len());
+    for (kb, l) in nb.iter().enumerate() {
+        for c in 0..3 {
+            let mut rows = Vec::with_capacity(3 * l.len());
+            for &ka in l {
+                let r0 = if ka == kb { c } else { 0 };
+                rows.extend((r0..3).map(|r| 3 * ka + r));
+            }
+            cols.push(rows);
+        }
+    }
+    cols
 }
 
 /// Local vertices of a stencil that carry dofs (the triangle and its existing flaps).

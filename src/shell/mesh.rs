@@ -44,21 +44,23 @@ impl Mesh {
         seed: u64,
     ) -> Result<Mesh, ShellError> {
         if !(width > 0.0 && height > 0.0 && edge > 0.0 && width.is_finite() && height.is_finite()) {
-            return Err(ShellError(format!(
-                "rectangle: width, height and edge must be positive (got {width}, {height}, {edge})"
-            )));
+            return Err(ShellError::Rectangle {
+                message: format!(
+                    "width, height and edge must be positive (got {width}, {height}, {edge})"
+                ),
+            });
         }
         if !(0.0..0.5).contains(&perturb) {
-            return Err(ShellError(format!(
-                "rectangle: perturb must be in [0, 0.5), got {perturb}"
-            )));
+            return Err(ShellError::Rectangle {
+                message: format!("perturb must be in [0, 0.5), got {perturb}"),
+            });
         }
         let nx = ((width / edge).round() as usize).max(1);
         let ny = ((height / edge).round() as usize).max(1);
         if (nx + 1) * (ny + 1) > 5_000_000 {
-            return Err(ShellError(format!(
-                "rectangle: {nx}x{ny} cells is too many"
-            )));
+            return Err(ShellError::Rectangle {
+                message: format!("{nx}x{ny} cells is too many"),
+            });
         }
         let (hx, hy) = (width / nx as f64, height / ny as f64);
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -100,10 +102,9 @@ impl Mesh {
     /// Read an OBJ file (`v` and `f` lines; other statements are ignored; polygons are fan-triangulated). The
     /// mesh must be flat in a plane z = const; returns the mesh and the 3D vertex positions.
     pub fn load_obj(path: &Path) -> Result<(Mesh, Vec<[f64; 3]>), ShellError> {
-        let name = path.display().to_string();
         let text = std::fs::read_to_string(path)
-            .map_err(|e| ShellError(format!("{name}: cannot read the mesh: {e}")))?;
-        Self::parse_obj(&text, &name)
+            .map_err(|e| ShellError::io(path, "cannot read the mesh", e))?;
+        Self::parse_obj(&text, &path.display().to_string())
     }
 
     /// Parse OBJ text; `name` is used in error messages.
@@ -114,7 +115,11 @@ impl Mesh {
         let mut origin = Vec::new();
         for (ln, line) in text.lines().enumerate() {
             let ln = ln + 1;
-            let err = |m: String| ShellError(format!("{name}:{ln}: {m}"));
+            let err = |message: String| ShellError::Obj {
+                file: name.to_string(),
+                line: Some(ln),
+                message,
+            };
             let line = line.split('#').next().unwrap_or("");
             let mut it = line.split_whitespace();
             match it.next() {
@@ -165,7 +170,11 @@ impl Mesh {
             }
         }
         if tris.is_empty() {
-            return Err(ShellError(format!("{name}: no faces")));
+            return Err(ShellError::Obj {
+                file: name.to_string(),
+                line: None,
+                message: "no faces".into(),
+            });
         }
         let (zmin, zmax) = pos
             .iter()
@@ -182,10 +191,14 @@ impl Mesh {
                 .enumerate()
                 .find(|(_, p)| (p[2] - zmin).abs() > 1e-9 * extent)
                 .expect("a vertex off the plane exists");
-            return Err(ShellError(format!(
-                "{name}:{}: the rest layout must be flat in a plane z = const (this vertex has z = {}, others {zmin})",
-                vline[k], pos[k][2]
-            )));
+            return Err(ShellError::Obj {
+                file: name.to_string(),
+                line: Some(vline[k]),
+                message: format!(
+                    "the rest layout must be flat in a plane z = const (this vertex has z = {}, others {zmin})",
+                    pos[k][2]
+                ),
+            });
         }
         let rest = pos.iter().map(|p| [p[0], p[1]]).collect();
         Ok((Mesh { rest, tris, origin }, pos))
@@ -209,10 +222,10 @@ impl Mesh {
         let mut rests = Vec::with_capacity(tris.len());
         for (t, tri) in tris.iter_mut().enumerate() {
             if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
-                return Err(ShellError(format!(
-                    "{}: degenerate triangle (repeated vertex)",
-                    self.origin[t]
-                )));
+                return Err(ShellError::Triangle {
+                    origin: self.origin[t].clone(),
+                    message: "degenerate triangle (repeated vertex)".into(),
+                });
             }
             let x = tri.map(|v| mat(self.rest[v]));
             let det = (x[1][0] - x[0][0]) * (x[2][1] - x[0][1])
@@ -221,11 +234,9 @@ impl Mesh {
                 tri.swap(1, 2);
             }
             let x = tri.map(|v| mat(self.rest[v]));
-            let r = RestTriangle::new(x[0], x[1], x[2]).ok_or_else(|| {
-                ShellError(format!(
-                    "{}: degenerate rest triangle (zero area)",
-                    self.origin[t]
-                ))
+            let r = RestTriangle::new(x[0], x[1], x[2]).ok_or_else(|| ShellError::Triangle {
+                origin: self.origin[t].clone(),
+                message: "degenerate rest triangle (zero area)".into(),
             })?;
             rests.push(r);
         }
@@ -236,14 +247,16 @@ impl Mesh {
                 let list = edges.entry((a.min(b), a.max(b))).or_default();
                 list.push((t, i));
                 if list.len() > 2 {
-                    return Err(ShellError(format!(
-                        "{}: non-manifold edge ({}, {}) shared by more than two triangles (also {} and {})",
-                        self.origin[t],
-                        a + 1,
-                        b + 1,
-                        self.origin[list[0].0],
-                        self.origin[list[1].0]
-                    )));
+                    return Err(ShellError::Triangle {
+                        origin: self.origin[t].clone(),
+                        message: format!(
+                            "non-manifold edge ({}, {}) shared by more than two triangles (also {} and {})",
+                            a + 1,
+                            b + 1,
+                            self.origin[list[0].0],
+                            self.origin[list[1].0]
+                        ),
+                    });
                 }
             }
         }

@@ -22,14 +22,127 @@ pub mod solver;
 pub use element::{ElementModel, ModelFlags, Psd};
 pub use mesh::{Mesh, Stencil};
 
-/// An error of the macro scale: one sentence naming the file, line or field at fault.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct ShellError(pub String);
+use std::path::{Path, PathBuf};
 
-impl std::fmt::Display for ShellError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
+/// An error of the macro scale: one sentence naming the file, line, field or value at fault.
+#[derive(Debug, thiserror::Error)]
+pub enum ShellError {
+    /// A file or folder could not be read or written.
+    #[error("{}: {action}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        /// What was being done ("cannot read", "cannot write", …).
+        action: &'static str,
+        source: std::io::Error,
+    },
+    /// A PNG snapshot could not be encoded or written.
+    #[error("{}: cannot write PNG: {source}", path.display())]
+    Png {
+        path: PathBuf,
+        source: image::ImageError,
+    },
+    /// A scene file that is not valid scene JSON (syntax, unknown or missing keys, wrong types).
+    #[error("{file}: {source}")]
+    Json {
+        file: String,
+        source: serde_json::Error,
+    },
+    /// Neither a scene file nor the name of a built-in scene.
+    #[error("{name}: no such scene file and not a built-in scene ({})", scene::BUILTINS.join(", "))]
+    UnknownScene { name: String },
+    /// A scene field with a value the scene cannot use.
+    #[error("{file}: field `{field}`: {message}")]
+    Scene {
+        file: String,
+        field: String,
+        message: String,
+    },
+    /// A vertex selection of a scene (a pin or a handle) that cannot be used.
+    #[error("{file}: field `{field}` {problem}")]
+    Selection {
+        file: String,
+        field: String,
+        /// "selects no vertex", "overlaps a pin"
+        problem: &'static str,
+    },
+    /// The material file a scene names could not be loaded.
+    #[error("{file}: field `material`: {source}")]
+    Material {
+        file: String,
+        source: crate::material::json::MaterialError,
+    },
+    /// The rectangle mesh a scene describes could not be generated.
+    #[error("{file}: field `mesh`: {source}")]
+    SceneMesh {
+        file: String,
+        source: Box<ShellError>,
+    },
+    /// A scene's simulation could not be set up.
+    #[error("{file}: {source}")]
+    SceneSetup {
+        file: String,
+        source: Box<ShellError>,
+    },
+    /// Bad rectangle dimensions.
+    #[error("rectangle: {message}")]
+    Rectangle { message: String },
+    /// A problem in an OBJ file, at a line when it has one.
+    #[error("{file}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Obj {
+        file: String,
+        line: Option<usize>,
+        message: String,
+    },
+    /// A bad triangle of a mesh; `origin` is where it came from (`file:line`, or a rectangle's triangle number).
+    #[error("{origin}: {message}")]
+    Triangle { origin: String, message: String },
+    /// A time step that is not a positive number.
+    #[error("time step must be positive, got {dt}")]
+    TimeStep { dt: f64 },
+    /// A pinned or handle vertex that the mesh does not have.
+    #[error("constrained vertex {vertex} out of range ({vertices} vertices)")]
+    VertexOutOfRange { vertex: usize, vertices: usize },
+    /// A vertex without positive mass in a dynamic simulation.
+    #[error(
+        "every vertex needs a positive mass (material density, mass multiplier, unused vertices?)"
+    )]
+    Mass,
+    /// The symbolic analysis of the Newton matrix failed.
+    #[error("symbolic factorisation failed: {source:?}")]
+    Symbolic { source: faer::sparse::FaerError },
+    /// A triangle of the initial state is degenerate.
+    #[error("a triangle is degenerate in the initial state")]
+    DegenerateInitial,
+    /// A triangle is degenerate at the start of a step (before any Newton iteration), at time `time`.
+    #[error(
+        "step {step} (t = {time:.4} s): a triangle is degenerate at the start of the step (handles moved too far \
+         in one step?)"
+    )]
+    DegenerateStart { step: usize, time: f64 },
+    /// A triangle became degenerate during a step's Newton iterations.
+    #[error("step {step}: a triangle became degenerate")]
+    Degenerate { step: usize },
+    /// The Newton matrix of a step could not be factorised at any diagonal shift.
+    #[error("step {step}: the Newton system could not be factorised even with a diagonal shift")]
+    Factorization { step: usize },
 }
 
-impl std::error::Error for ShellError {}
+impl ShellError {
+    /// An I/O error on `path` while doing `action`.
+    pub fn io(path: &Path, action: &'static str, source: std::io::Error) -> Self {
+        ShellError::Io {
+            path: path.to_path_buf(),
+            action,
+            source,
+        }
+    }
+
+    /// A bad value of a scene field.
+    pub fn scene(file: &str, field: &str, message: impl Into<String>) -> Self {
+        ShellError::Scene {
+            file: file.to_string(),
+            field: field.to_string(),
+            message: message.into(),
+        }
+    }
+}

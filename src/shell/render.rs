@@ -2,6 +2,7 @@
 //! open"): orthographic view from an azimuth and elevation, z-buffer, two-sided Lambert shading, 2× supersampling,
 //! written as PNG. Obstacles are drawn as meshes ([`sphere_mesh`]) in their own colour.
 
+use super::ShellError;
 use crate::real::{cross, dot};
 use std::path::Path;
 
@@ -218,10 +219,14 @@ fn fill_triangle(
 }
 
 /// Render and write a PNG.
-pub fn write_png(path: &Path, layers: &[Layer], view: &View) -> Result<(), String> {
+pub fn write_png(path: &Path, layers: &[Layer], view: &View) -> Result<(), ShellError> {
     let rgb = render(layers, view);
-    image::save_buffer(path, &rgb, view.width, view.height, image::ColorType::Rgb8)
-        .map_err(|e| format!("{}: cannot write PNG: {e}", path.display()))
+    image::save_buffer(path, &rgb, view.width, view.height, image::ColorType::Rgb8).map_err(
+        |source| ShellError::Png {
+            path: path.to_path_buf(),
+            source,
+        },
+    )
 }
 
 #[cfg(test)]

@@ -254,8 +254,7 @@ pub const BUILTINS: [&str; 5] = ["stretch-x", "stretch-y", "drape-x", "drape-y",
 pub const SIDE: f64 = 0.3;
 pub const BUILTIN_EDGE: f64 = 0.3 / 51.0;
 
-/// A built-in scene matching the original's tests (30 × 30 cm, 1 s at 1/60 s steps, PSD option `psi`: on the
-/// stretch scene with basket1 it reaches the same states as `full` at about a third of the wall time):
+/// A built-in scene matching the original's tests (30 × 30 cm, 1 s at 1/60 s steps, PSD option `psi`):
 /// - `stretch-x` / `stretch-y`: two strips on opposite sides (67 % of the side long, 7 % of it wide, inset 16.5 %
 ///   from the corners) pulled apart 2 cm each over 0.25 s, then held; gravity on.
 /// - `drape-x` / `drape-y`: the square held at the two corners of its edge along the fabric x (y) axis (vertices
@@ -340,7 +339,10 @@ pub fn builtin(name: &str) -> Option<Scene> {
 impl Scene {
     /// Parse scene JSON; `name` (the file) is used in error messages.
     pub fn from_json_str(text: &str, name: &str) -> Result<Scene, ShellError> {
-        serde_json::from_str(text).map_err(|e| ShellError(format!("{name}: {e}")))
+        serde_json::from_str(text).map_err(|source| ShellError::Json {
+            file: name.to_string(),
+            source,
+        })
     }
 
     /// Read a scene file, or a built-in by name when no such file exists.
@@ -350,13 +352,11 @@ impl Scene {
             if let Some(s) = builtin(arg) {
                 return Ok((s, PathBuf::from(".")));
             }
-            return Err(ShellError(format!(
-                "{arg}: no such scene file and not a built-in scene ({})",
-                BUILTINS.join(", ")
-            )));
+            return Err(ShellError::UnknownScene {
+                name: arg.to_string(),
+            });
         }
-        let text = std::fs::read_to_string(p)
-            .map_err(|e| ShellError(format!("{arg}: cannot read: {e}")))?;
+        let text = std::fs::read_to_string(p).map_err(|e| ShellError::io(p, "cannot read", e))?;
         let s = Scene::from_json_str(&text, arg)?;
         let dir = p.parent().map(Path::to_path_buf).unwrap_or_default();
         Ok((s, dir))
@@ -364,8 +364,7 @@ impl Scene {
 
     /// Check values serde cannot (positive sizes and times); errors name the field.
     fn validate(&self, file: &str) -> Result<(), ShellError> {
-        let bad =
-            |field: &str, msg: String| Err(ShellError(format!("{file}: field `{field}`: {msg}")));
+        let bad = |field: &str, msg: String| Err(ShellError::scene(file, field, msg));
         if !(self.duration >= 0.0 && self.duration.is_finite()) {
             return bad(
                 "duration",
@@ -434,7 +433,10 @@ impl Scene {
             default_material()
         } else {
             let p = dir.join(&self.material);
-            Material::load(&p).map_err(|e| ShellError(format!("{file}: field `material`: {e}")))?
+            Material::load(&p).map_err(|source| ShellError::Material {
+                file: file.to_string(),
+                source,
+            })?
         };
         let (mesh, x0) = match &self.mesh {
             MeshSpec::Rectangle {
@@ -444,8 +446,12 @@ impl Scene {
                 perturb,
                 seed,
             } => {
-                let m = Mesh::rectangle(*width, *height, *edge, *perturb, *seed)
-                    .map_err(|e| ShellError(format!("{file}: field `mesh`: {e}")))?;
+                let m = Mesh::rectangle(*width, *height, *edge, *perturb, *seed).map_err(|e| {
+                    ShellError::SceneMesh {
+                        file: file.to_string(),
+                        source: Box::new(e),
+                    }
+                })?;
                 let pl = &self.placement;
                 let x0 = m.place(pl.origin, pl.u, pl.v);
                 (m, x0)
@@ -466,9 +472,11 @@ impl Scene {
         for (i, sel) in self.pins.iter().enumerate() {
             let v = sel.select(&mesh);
             if v.is_empty() {
-                return Err(ShellError(format!(
-                    "{file}: field `pins[{i}]` selects no vertex"
-                )));
+                return Err(ShellError::Selection {
+                    file: file.to_string(),
+                    field: format!("pins[{i}]"),
+                    problem: "selects no vertex",
+                });
             }
             pins.extend(v);
         }
@@ -476,14 +484,18 @@ impl Scene {
         for (i, h) in self.handles.iter().enumerate() {
             let v = h.select.select(&mesh);
             if v.is_empty() {
-                return Err(ShellError(format!(
-                    "{file}: field `handles[{i}].select` selects no vertex"
-                )));
+                return Err(ShellError::Selection {
+                    file: file.to_string(),
+                    field: format!("handles[{i}].select"),
+                    problem: "selects no vertex",
+                });
             }
             if v.iter().any(|x| pins.contains(x)) {
-                return Err(ShellError(format!(
-                    "{file}: field `handles[{i}].select` overlaps a pin"
-                )));
+                return Err(ShellError::Selection {
+                    file: file.to_string(),
+                    field: format!("handles[{i}].select"),
+                    problem: "overlaps a pin",
+                });
             }
             handles.push(Handle {
                 name: h.name.clone(),
@@ -514,7 +526,10 @@ impl Scene {
             settings,
             self.model.mass,
         )
-        .map_err(|e| ShellError(format!("{file}: {e}")))?;
+        .map_err(|e| ShellError::SceneSetup {
+            file: file.to_string(),
+            source: Box::new(e),
+        })?;
         Ok((sim, tris))
     }
 
@@ -549,10 +564,11 @@ pub fn run(
     out: Option<&Path>,
     mut progress: impl FnMut(&StepReport),
 ) -> Result<RunSummary, ShellError> {
-    let io = |e: std::io::Error, what: &Path| ShellError(format!("{}: {e}", what.display()));
+    let io = |e: std::io::Error, what: &Path| ShellError::io(what, "cannot write", e);
     let mut log = match out {
         Some(dir) => {
-            std::fs::create_dir_all(dir).map_err(|e| io(e, dir))?;
+            std::fs::create_dir_all(dir)
+                .map_err(|e| ShellError::io(dir, "cannot create the folder", e))?;
             if obj_every > 0 {
                 let f = dir.join("frame_0000.obj");
                 write_obj(&f, &sim.positions(), tris).map_err(|e| io(e, &f))?;

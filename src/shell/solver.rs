@@ -5,13 +5,13 @@
 //! Φ(x) = ½‖x − x̃‖²_M / h² + (c/2h)‖x − xₙ‖²_M + E(x) − Σ m_v g·x_v + E_obst(x)
 //! (c the linear drag rate, 1/s: implicit drag force −c m v); quasi-static mode minimises E − Σ m g·x + E_obst.
 //! Newton's method with a backtracking (Armijo) line search on Φ; converged when the largest residual force on
-//! a free vertex, ‖∂Φ/∂x_v‖, is below the force tolerance. The sparse Hessian (free dofs only) is factorised by
-//! faer's sparse Cholesky with the symbolic analysis computed once per simulation. With `exact_first` (default) the
-//! exact Hessian is factorised first and the PSD option's Hessian (`05-macro.md`, options (a)–(c)) used only when
-//! that fails (not positive definite): projected Newton far from the solution, Newton's quadratic convergence near
-//! it. If the numeric factorisation of the projected Hessian
-//! fails (an indefinite matrix, possible with [`Psd::None`](super::Psd) or in quasi-static mode) a diagonal shift
-//! μ I is added and increased tenfold until it succeeds.
+//! a free vertex, ‖∂Φ/∂x_v‖, is below the force tolerance. The sparse Hessian (free dofs only, the lower triangle
+//! in the pattern of [`assemble`](super::assemble)) is factorised by faer's sparse Cholesky with the symbolic
+//! analysis computed once per simulation. With `exact_first` (default) the exact Hessian is factorised first and
+//! the PSD option's Hessian (`05-macro.md`, options (a)–(c)) used only when that fails (not positive definite):
+//! projected Newton far from the solution, Newton's quadratic convergence near it. If the numeric factorisation
+//! of the projected Hessian fails (an indefinite matrix, possible with [`Psd::None`](super::Psd) or in
+//! quasi-static mode) a diagonal shift μ I is added and increased tenfold until it succeeds.
 //!
 //! Boundary conditions by dof elimination: pinned vertices keep their initial positions; handle vertices follow
 //! keyframed translations (piecewise linear in time, held after the last key). The reaction force of a handle is
@@ -22,13 +22,13 @@
 //! p = δ − d > 0 into the layer of thickness δ around the surface (d the signed distance); C² at p = 0. Its
 //! Hessian keeps the PSD part 2 m k p n̂n̂ᵀ (the sphere's curvature term is negative and dropped).
 
-use super::assemble::{assemble, energy, Pattern};
+use super::assemble::{assemble, energy, Assembled, Pattern};
 use super::element::ElementModel;
 use super::mesh::Stencil;
 use super::ShellError;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::sparse::SparseColMatRef;
 use faer::Side;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -211,6 +211,21 @@ struct Target {
     xn: Vec<f64>,
 }
 
+/// Where the Newton iterations of a step ended.
+struct Minimum {
+    x: Vec<f64>,
+    /// Newton iterations taken
+    newton: usize,
+    /// largest residual force on a free vertex at x (N)
+    residual: f64,
+    converged: bool,
+    /// the largest diagonal shift a factorisation needed
+    max_shift: f64,
+    /// the assembly and the full gradient of Φ at x
+    asm: Assembled,
+    g_full: Vec<f64>,
+}
+
 impl Simulation {
     /// Set up a simulation: `x0` the initial positions (3 per vertex), `mass_multiplier` scales the lumped mass
     /// from the material density.
@@ -229,10 +244,7 @@ impl Simulation {
         } = boundary;
         let n = x0.len();
         if !(settings.dt > 0.0 && settings.dt.is_finite()) {
-            return Err(ShellError(format!(
-                "time step must be positive, got {}",
-                settings.dt
-            )));
+            return Err(ShellError::TimeStep { dt: settings.dt });
         }
         let mut constrained = vec![false; n];
         for &v in pinned
@@ -240,9 +252,10 @@ impl Simulation {
             .chain(handles.iter().flat_map(|h| h.vertices.iter()))
         {
             if v >= n {
-                return Err(ShellError(format!(
-                    "constrained vertex {v} out of range ({n} vertices)"
-                )));
+                return Err(ShellError::VertexOutOfRange {
+                    vertex: v,
+                    vertices: n,
+                });
             }
             constrained[v] = true;
         }
@@ -254,26 +267,14 @@ impl Simulation {
             }
         }
         if !settings.quasi_static && mass.iter().any(|&m| m.is_nan() || m <= 0.0) {
-            return Err(ShellError(
-                "every vertex needs a positive mass (material density, mass multiplier, unused vertices?)"
-                    .into(),
-            ));
+            return Err(ShellError::Mass);
         }
         let pattern = Pattern::new(&stencils, n, &constrained);
-        let sym = SymbolicSparseColMatRef::new_checked(
-            3 * pattern.nfree,
-            3 * pattern.nfree,
-            &pattern.col_ptr,
-            None,
-            &pattern.row_idx,
-        );
-        let symbolic = SymbolicLlt::try_new(sym, Side::Lower)
-            .map_err(|e| ShellError(format!("symbolic factorisation failed: {e:?}")))?;
+        let symbolic = SymbolicLlt::try_new(pattern.lower.symbolic(), Side::Lower)
+            .map_err(|source| ShellError::Symbolic { source })?;
         let x: Vec<f64> = x0.iter().flatten().copied().collect();
         if energy(&model, &stencils, &x).is_none() {
-            return Err(ShellError(
-                "a triangle is degenerate in the initial state".into(),
-            ));
+            return Err(ShellError::DegenerateInitial);
         }
         Ok(Simulation {
             model,
@@ -356,12 +357,61 @@ impl Simulation {
         (val, ())
     }
 
-    /// Advance one step.
+    /// Advance one step: minimise Φ from the start of the step ([`start_of_step`](Self::start_of_step)) by
+    /// Newton's method ([`minimise`](Self::minimise)), then take the minimiser as the new state.
     pub fn step(&mut self) -> Result<StepReport, ShellError> {
         let start = Instant::now();
-        let s = self.settings.clone();
-        let h = s.dt;
+        let h = self.settings.dt;
         let t1 = self.time + h;
+        let (tg, x) = self.start_of_step(t1);
+        let phi = self.potential(&x, &tg).ok_or(ShellError::DegenerateStart {
+            step: self.steps + 1,
+            time: t1,
+        })?;
+        let m = self.minimise(x, &tg, phi)?;
+        // reactions: the full gradient of Φ at the handle vertices (`asm` and `g_full` are evaluated at x,
+        // except after a failed line search, where x did not change either)
+        let handle_forces = self.handle_forces(&m.g_full);
+        // update state
+        let x = m.x;
+        for i in 0..x.len() {
+            self.v[i] = if self.settings.quasi_static {
+                0.0
+            } else {
+                (x[i] - tg.xn[i]) / h
+            };
+        }
+        self.x = x;
+        self.time = t1;
+        self.steps += 1;
+        let (ek, eg, eo) = self.energies();
+        let asm = m.asm;
+        Ok(StepReport {
+            step: self.steps,
+            time: self.time,
+            newton: m.newton,
+            residual: m.residual,
+            converged: m.converged,
+            energy_elastic: asm.energy,
+            energy_kinetic: ek,
+            energy_gravity: eg,
+            energy_obstacles: eo,
+            handle_forces,
+            shift: m.max_shift,
+            wall: start.elapsed().as_secs_f64(),
+            strain_min: asm.zmin,
+            strain_max: asm.zmax,
+            strain_p01: strain_quantile(&asm.z, 0.01),
+            strain_p99: strain_quantile(&asm.z, 0.99),
+        })
+    }
+
+    /// The constants of the step ending at `t1` (x̃ = xₙ + h vₙ, xₙ) and the starting point of its minimisation:
+    /// pinned and handle vertices at their prescribed positions, the free ones at the inertial prediction x̃ when Φ
+    /// is defined there, else at xₙ (always xₙ in quasi-static mode).
+    fn start_of_step(&self, t1: f64) -> (Target, Vec<f64>) {
+        let s = &self.settings;
+        let h = s.dt;
         let n = self.pattern.n;
         let xn = self.x.clone();
         let mut xt = xn.clone();
@@ -403,74 +453,100 @@ impl Simulation {
                 x = guess;
             }
         }
-        let mut phi = self.potential(&x, &tg).ok_or_else(|| {
-            ShellError(format!(
-                "step {} (t = {t1:.4} s): a triangle is degenerate at the start of the step (handles moved too far in one step?)",
-                self.steps + 1
-            ))
-        })?;
+        (tg, x)
+    }
+
+    /// Newton's method on Φ from `x` (where Φ = `phi`): converged when the largest residual force on a free
+    /// vertex is below the tolerance (or there is no free vertex); stops unconverged after `max_newton`
+    /// iterations or when the line search finds no decrease.
+    fn minimise(&self, mut x: Vec<f64>, tg: &Target, mut phi: f64) -> Result<Minimum, ShellError> {
+        let s = &self.settings;
         let nf = 3 * self.pattern.nfree;
         let mut newton = 0;
-        let mut residual;
-        let mut converged = false;
         let mut max_shift: f64 = 0.0;
-        let (mut last, mut g_full);
         loop {
-            (last, g_full) = self.gradient_hessian(&x, &tg)?;
-            // residual over free vertices
-            let mut gf = vec![0.0; nf];
-            residual = 0.0f64;
-            for v in 0..n {
-                if let Some(k) = self.pattern.free[v] {
-                    let f2: f64 = (0..3).map(|c| g_full[3 * v + c].powi(2)).sum();
-                    residual = residual.max(f2.sqrt());
-                    for c in 0..3 {
-                        gf[3 * k + c] = g_full[3 * v + c];
-                    }
+            let (asm, g_full) = self.gradient_hessian(&x, tg)?;
+            let (gf, residual) = self.free_gradient(&g_full);
+            let converged = residual <= s.force_tol || nf == 0;
+            let mut step = None;
+            if !converged && newton < s.max_newton {
+                newton += 1;
+                let (d, shift) = self.solve(&asm.values, &asm.values_exact, &gf)?;
+                max_shift = max_shift.max(shift);
+                let slope: f64 = gf.iter().zip(&d).map(|(a, b)| a * b).sum();
+                step = self.line_search(&x, &d, slope, phi, tg);
+            }
+            match step {
+                Some((xtry, p)) => {
+                    x = xtry;
+                    phi = p;
+                }
+                None => {
+                    return Ok(Minimum {
+                        x,
+                        newton,
+                        residual,
+                        converged,
+                        max_shift,
+                        asm,
+                        g_full,
+                    })
                 }
             }
-            if residual <= s.force_tol || nf == 0 {
-                converged = true;
-                break;
-            }
-            if newton >= s.max_newton {
-                break;
-            }
-            newton += 1;
-            let (d, shift) = self.solve(&last.values, &last.values_exact, &gf)?;
-            max_shift = max_shift.max(shift);
-            let slope: f64 = gf.iter().zip(&d).map(|(a, b)| a * b).sum();
-            let mut alpha = 1.0;
-            let mut accepted = false;
-            let mut xtry = x.clone();
-            while alpha > 1e-12 {
-                for v in 0..n {
-                    if let Some(k) = self.pattern.free[v] {
-                        for c in 0..3 {
-                            xtry[3 * v + c] = x[3 * v + c] + alpha * d[3 * k + c];
-                        }
-                    }
-                }
-                if let Some(p) = self.potential(&xtry, &tg) {
-                    // Armijo, with an allowance for round-off in Φ near convergence
-                    if p <= phi + 1e-4 * alpha * slope + 1e-13 * phi.abs() {
-                        phi = p;
-                        accepted = true;
-                        break;
-                    }
-                }
-                alpha *= 0.5;
-            }
-            if !accepted {
-                break;
-            }
-            std::mem::swap(&mut x, &mut xtry);
         }
-        let asm = last;
-        // reactions: the full gradient of Φ at the handle vertices (`last` and `g_full` are evaluated at x,
-        // except after a failed line search, where x did not change either)
-        let handle_forces = self
-            .handles
+    }
+
+    /// The gradient of Φ over the free dofs (free index order) and the largest residual force ‖∂Φ/∂x_v‖ on a free
+    /// vertex.
+    fn free_gradient(&self, g_full: &[f64]) -> (Vec<f64>, f64) {
+        let mut gf = vec![0.0; 3 * self.pattern.nfree];
+        let mut residual = 0.0f64;
+        for v in 0..self.pattern.n {
+            if let Some(k) = self.pattern.free[v] {
+                let f2: f64 = (0..3).map(|c| g_full[3 * v + c].powi(2)).sum();
+                residual = residual.max(f2.sqrt());
+                for c in 0..3 {
+                    gf[3 * k + c] = g_full[3 * v + c];
+                }
+            }
+        }
+        (gf, residual)
+    }
+
+    /// Backtracking (Armijo) line search on Φ from `x` along the free-dof direction `d` with slope gᵀd: steps
+    /// α = 1, ½, … down to 1e-12. Returns the accepted point and its Φ.
+    fn line_search(
+        &self,
+        x: &[f64],
+        d: &[f64],
+        slope: f64,
+        phi: f64,
+        tg: &Target,
+    ) -> Option<(Vec<f64>, f64)> {
+        let mut alpha = 1.0;
+        let mut xtry = x.to_vec();
+        while alpha > 1e-12 {
+            for v in 0..self.pattern.n {
+                if let Some(k) = self.pattern.free[v] {
+                    for c in 0..3 {
+                        xtry[3 * v + c] = x[3 * v + c] + alpha * d[3 * k + c];
+                    }
+                }
+            }
+            if let Some(p) = self.potential(&xtry, tg) {
+                // Armijo, with an allowance for round-off in Φ near convergence
+                if p <= phi + 1e-4 * alpha * slope + 1e-13 * phi.abs() {
+                    return Some((xtry, p));
+                }
+            }
+            alpha *= 0.5;
+        }
+        None
+    }
+
+    /// The force each handle exerts on the cloth: the sum of the full gradient of Φ over its vertices.
+    fn handle_forces(&self, g_full: &[f64]) -> Vec<(String, [f64; 3])> {
+        self.handles
             .iter()
             .map(|hd| {
                 let mut f = [0.0; 3];
@@ -481,22 +557,17 @@ impl Simulation {
                 }
                 (hd.name.clone(), f)
             })
-            .collect();
-        // update state
-        for i in 0..x.len() {
-            self.v[i] = if s.quasi_static {
-                0.0
-            } else {
-                (x[i] - xn[i]) / h
-            };
-        }
-        self.x = x;
-        self.time = t1;
-        self.steps += 1;
+            .collect()
+    }
+
+    /// Kinetic energy, gravitational potential energy relative to the initial state and obstacle energy of the
+    /// current state.
+    fn energies(&self) -> (f64, f64, f64) {
+        let s = &self.settings;
         let mut ek = 0.0;
         let mut eg = 0.0;
         let mut eo = 0.0;
-        for v in 0..n {
+        for v in 0..self.pattern.n {
             let m = self.mass[v];
             let p = [self.x[3 * v], self.x[3 * v + 1], self.x[3 * v + 2]];
             for c in 0..3 {
@@ -505,24 +576,7 @@ impl Simulation {
             }
             eo += self.obstacle_terms(v, p).0;
         }
-        Ok(StepReport {
-            step: self.steps,
-            time: self.time,
-            newton,
-            residual,
-            converged,
-            energy_elastic: asm.energy,
-            energy_kinetic: ek,
-            energy_gravity: eg,
-            energy_obstacles: eo,
-            handle_forces,
-            shift: max_shift,
-            wall: start.elapsed().as_secs_f64(),
-            strain_min: asm.zmin,
-            strain_max: asm.zmax,
-            strain_p01: strain_quantile(&asm.z, 0.01),
-            strain_p99: strain_quantile(&asm.z, 0.99),
-        })
+        (ek, eg, eo)
     }
 
     /// The first Newton direction of the next step at the current state (assembly, factorisation, solve): one
@@ -554,7 +608,7 @@ impl Simulation {
         &self,
         x: &[f64],
         tg: &Target,
-    ) -> Result<(super::assemble::Assembled, Vec<f64>), ShellError> {
+    ) -> Result<(Assembled, Vec<f64>), ShellError> {
         let s = &self.settings;
         let h = s.dt;
         let mut asm = assemble(
@@ -565,11 +619,8 @@ impl Simulation {
             true,
             self.exact_first(),
         )
-        .ok_or_else(|| {
-            ShellError(format!(
-                "step {}: a triangle became degenerate",
-                self.steps + 1
-            ))
+        .ok_or(ShellError::Degenerate {
+            step: self.steps + 1,
         })?;
         let mut g = std::mem::take(&mut asm.grad);
         for v in 0..self.pattern.n {
@@ -610,26 +661,15 @@ impl Simulation {
         g: &[f64],
     ) -> Result<(Vec<f64>, f64), ShellError> {
         let nf = g.len();
-        let sym = SymbolicSparseColMatRef::new_checked(
-            nf,
-            nf,
-            &self.pattern.col_ptr,
-            None,
-            &self.pattern.row_idx,
-        );
         if !exact.is_empty() {
-            let mat = SparseColMatRef::new(sym, exact);
-            if let Ok(llt) = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower) {
-                let mut d: Vec<f64> = g.iter().map(|x| -x).collect();
-                llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut d, nf, 1));
-                if d.iter().all(|x| x.is_finite()) {
-                    return Ok((d, 0.0));
-                }
+            if let Some(d) = self.factor_solve(exact, g) {
+                return Ok((d, 0.0));
             }
         }
         let mut shift = 0.0;
         let mean_diag = self
             .pattern
+            .lower
             .diag
             .iter()
             .map(|&k| values[k].abs())
@@ -643,24 +683,30 @@ impl Simulation {
                 } else {
                     10.0 * shift
                 };
-                for &k in &self.pattern.diag {
+                for &k in &self.pattern.lower.diag {
                     vals[k] += new_shift - shift;
                 }
                 shift = new_shift;
             }
-            let mat = SparseColMatRef::new(sym, &vals);
-            if let Ok(llt) = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower) {
-                let mut d: Vec<f64> = g.iter().map(|x| -x).collect();
-                llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut d, nf, 1));
-                if d.iter().all(|x| x.is_finite()) {
-                    return Ok((d, shift));
-                }
+            if let Some(d) = self.factor_solve(&vals, g) {
+                return Ok((d, shift));
             }
         }
-        Err(ShellError(format!(
-            "step {}: the Newton system could not be factorised even with a diagonal shift",
-            self.steps + 1
-        )))
+        Err(ShellError::Factorization {
+            step: self.steps + 1,
+        })
+    }
+
+    /// d = −H⁻¹ g for the free-dof matrix H with the lower-triangle `values` (the pattern's order): the numeric
+    /// Cholesky factorisation with the simulation's symbolic analysis, then one solve. `None` when H is not
+    /// positive definite or d is not finite.
+    fn factor_solve(&self, values: &[f64], g: &[f64]) -> Option<Vec<f64>> {
+        let nf = g.len();
+        let mat = SparseColMatRef::new(self.pattern.lower.symbolic(), values);
+        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower).ok()?;
+        let mut d: Vec<f64> = g.iter().map(|x| -x).collect();
+        llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut d, nf, 1));
+        d.iter().all(|x| x.is_finite()).then_some(d)
     }
 }
 

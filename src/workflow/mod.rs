@@ -88,9 +88,6 @@ pub enum WorkflowError {
         samples: PathBuf,
         source: crate::fit::FitError,
     },
-    /// A stage that reports its errors as text (the PNG snapshot).
-    #[error("{0}")]
-    Stage(String),
     /// Bad input to a workflow, with the argument or file at fault.
     #[error("{0}")]
     Input(String),
@@ -104,12 +101,6 @@ impl WorkflowError {
             action,
             source,
         }
-    }
-}
-
-impl From<String> for WorkflowError {
-    fn from(s: String) -> Self {
-        WorkflowError::Stage(s)
     }
 }
 

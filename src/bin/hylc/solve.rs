@@ -55,6 +55,15 @@ pub struct Args {
 
 /// `hylc solve`: exit code 3 when a solve did not converge.
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    if a.trace {
+        // the solver's per-step lines (`tracing` events at info level) as plain lines on stderr
+        tracing_subscriber::fmt()
+            .with_writer(std::io::stderr)
+            .without_time()
+            .with_level(false)
+            .with_target(false)
+            .init();
+    }
     let options = SolverOptions {
         trace: a.trace,
         step_factor: a.step_factor,
