@@ -16,11 +16,11 @@
 //! The slope at i_min: for in-plane strains (i_min the knot at 0) it is set to 0, as in the original materials,
 //! so that f_k(0) = 0 is the minimum and the rest state z = 0 is an equilibrium of ψ along every in-plane axis.
 //! Finite differences of g across a kink of Ψ̄ at 0 (a knit is far softer in compression than in tension) give a
-//! slope there of the tension side's sign, and the cell on the compression side would dip below f₀ (by 7 % of f₀
-//! on the generated stockinette with 30 samples). For bending (i_min = argmin p) the slope is only limited by
-//! step 4 on the side its sign points to; the cell on the other side then has slopes of opposite signs at its
-//! ends, and a cubic Hermite cell whose end slopes are (−, +) has a quadratic derivative with exactly one root in
-//! the cell, so the spline stays quasi-convex (its minimum may sit slightly off the knot).
+//! slope there of the tension side's sign, and the cell on the compression side would dip below f₀. For bending
+//! (i_min = argmin p) the slope is only limited by step 4 on the side its sign points to; the cell on the other
+//! side then has slopes of opposite signs at its ends, and a cubic Hermite cell whose end slopes are (−, +) has a
+//! quadratic derivative with exactly one root in the cell, so the spline stays quasi-convex (its minimum may sit
+//! slightly off the knot).
 
 use super::mls::{Mls1D, DEFAULT_BANDWIDTH_FACTOR};
 use super::symlog::{symexp, symlog_samples};

@@ -37,10 +37,9 @@
 //! 8. Bounded extrapolation (our addition): the residual's slope across the boundary of the knot box is set to 0
 //!    (pˣ on the first and last knot column, pʸ on the first and last row), so r continues as a constant beyond
 //!    the sampled box and only the 1D terms, which rise outward, extrapolate. Without it the linear continuation
-//!    of r, the difference of two fits' boundary slopes, can fall faster than the 1D terms rise: on the generated
-//!    stockinette with the quick plan ψ reached −186 J/m² at (s_x, s_y, II₀₀) = (1.95, −0.5, −1848 m⁻¹), and a
-//!    drape fell into that well. The changed slopes only reshape the boundary patches, which the report's errors
-//!    include.
+//!    of r, the difference of two fits' boundary slopes, can fall faster than the 1D terms rise, and ψ gets a well
+//!    of negative energy beyond the sampled box that a simulation can fall into. The changed slopes only reshape
+//!    the boundary patches, which the report's errors include.
 //!
 //! The unconverted spline f of step 5 is returned too ([`Fit2D::full`]): its errors against the samples are the
 //! fit's own quality; the material uses the residual.
