@@ -16,11 +16,11 @@
 //! The slope at i_min: for in-plane strains (i_min the knot at 0) it is set to 0, as in the original materials,
 //! so that f_k(0) = 0 is the minimum and the rest state z = 0 is an equilibrium of ψ along every in-plane axis.
 //! Finite differences of g across a kink of Ψ̄ at 0 (a knit is far softer in compression than in tension) give a
-//! slope there of the tension side's sign, and the cell on the compression side would dip below f₀ (by 7 % of f₀
-//! on the generated stockinette with 30 samples). For bending (i_min = argmin p) the slope is only limited by
-//! step 4 on the side its sign points to; the cell on the other side then has slopes of opposite signs at its
-//! ends, and a cubic Hermite cell whose end slopes are (−, +) has a quadratic derivative with exactly one root in
-//! the cell, so the spline stays quasi-convex (its minimum may sit slightly off the knot).
+//! slope there of the tension side's sign, and the cell on the compression side would dip below f₀. For bending
+//! (i_min = argmin p) the slope is only limited by step 4 on the side its sign points to; the cell on the other
+//! side then has slopes of opposite signs at its ends, and a cubic Hermite cell whose end slopes are (−, +) has a
+//! quadratic derivative with exactly one root in the cell, so the spline stays quasi-convex (its minimum may sit
+//! slightly off the knot).
 
 use super::mls::{Mls1D, DEFAULT_BANDWIDTH_FACTOR};
 use super::symlog::{symexp, symlog_samples};
@@ -122,15 +122,14 @@ pub fn fit1d(x: &[f64], psi: &[f64], opts: &Fit1DOptions) -> Result<Fit1D, FitEr
     fit1d_with_stress(x, psi, None, opts)
 }
 
-/// [`fit1d`] with the sampled stresses dΨ/dX (same length as `x`; non-finite entries are dropped with their
-/// sample), used for the slopes when `opts.slopes` is [`SlopeSource::Stress`]: pˣ = MLS(t | X, dΨ/dX), the odd part
-/// ½(MLS(t) − MLS(−t)) for s_a. An error when stresses are asked for but not given.
-pub fn fit1d_with_stress(
+/// The input checks of [`fit1d_with_stress`]: the stresses' length, stresses present when the slopes come from
+/// them, the samples' lengths and the options.
+fn check_inputs(
     x: &[f64],
     psi: &[f64],
     stress: Option<&[f64]>,
     opts: &Fit1DOptions,
-) -> Result<Fit1D, FitError> {
+) -> Result<(), FitError> {
     if let Some(st) = stress {
         if st.len() != x.len() {
             return Err(FitError::LengthMismatch {
@@ -150,54 +149,91 @@ pub fn fit1d_with_stress(
             psi: psi.len(),
         });
     }
-    check_options(opts)?;
-    let (xs, ys): (Vec<f64>, Vec<f64>) = x
-        .iter()
-        .zip(psi)
-        .filter(|(a, b)| a.is_finite() && b.is_finite())
-        .map(|(&a, &b)| (a, b))
-        .unzip();
-    let n_excluded = x.len() - xs.len();
+    check_options(opts)
+}
 
-    // step 1: g = symexp ∘ MLS ∘ symlog
-    let (eps, logs) = symlog_samples(&ys, opts.eps_rel);
-    let mls = Mls1D::new(&xs, &logs, opts.bandwidth_factor)?;
-    let g = |u: f64| {
-        let w = if opts.symmetric {
-            mls.eval_symmetric(u)
-        } else {
-            mls.eval(u)
-        };
-        symexp(w, eps)
-    };
+/// Step 1: g(u) = symexp(MLS(u | X, symlog Ψ)), ε = `eps_rel` · max|Ψ|, symmetrised MLS for s_a.
+struct Smoothed {
+    mls: Mls1D,
+    eps: f64,
+    symmetric: bool,
+}
 
-    // step 2: knots at multiples of h inside [0.95 min X, 0.95 max X]
-    let (lo, hi) = xs
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
-            (l.min(v), h.max(v))
-        });
-    let h = 0.95 * (hi - lo) / (opts.n_knots - 1) as f64;
-    // a relative tolerance keeps a multiple that lands on the bound despite rounding
-    let k_lo = (0.95 * lo / h - 1e-9).ceil() as i64;
-    let k_hi = (0.95 * hi / h + 1e-9).floor() as i64;
-    if k_hi - k_lo < 1 {
-        return Err(FitError::Knots(format!(
-            "fewer than two multiples of h = {h} in [{}, {}]",
-            0.95 * lo,
-            0.95 * hi
-        )));
-    }
-    let t: Vec<f64> = (k_lo..=k_hi).map(|k| k as f64 * h).collect();
-    let curve: Vec<[f64; 2]> = (0..=200)
-        .map(|i| {
-            let u = lo + (hi - lo) * i as f64 / 200.0;
-            [u, g(u)]
+impl Smoothed {
+    fn new(xs: &[f64], ys: &[f64], opts: &Fit1DOptions) -> Result<Self, FitError> {
+        let (eps, logs) = symlog_samples(ys, opts.eps_rel);
+        let mls = Mls1D::new(xs, &logs, opts.bandwidth_factor)?;
+        Ok(Smoothed {
+            mls,
+            eps,
+            symmetric: opts.symmetric,
         })
-        .collect();
-    let mut p: Vec<f64> = t.iter().map(|&u| g(u)).collect();
-    let d = opts.fd_step * h;
-    let mut m: Vec<f64> = match (opts.slopes, stress) {
+    }
+
+    fn g(&self, u: f64) -> f64 {
+        let w = if self.symmetric {
+            self.mls.eval_symmetric(u)
+        } else {
+            self.mls.eval(u)
+        };
+        symexp(w, self.eps)
+    }
+}
+
+/// Step 2's knots: the multiples k h, k = k_lo..=k_hi, of h = 0.95 (hi − lo)/(N_c − 1) inside
+/// [0.95 lo, 0.95 hi].
+struct Knots {
+    t: Vec<f64>,
+    h: f64,
+    k_lo: i64,
+    k_hi: i64,
+}
+
+impl Knots {
+    /// The knots for samples spanning [lo, hi]; an error when fewer than two multiples of h fit.
+    fn new(lo: f64, hi: f64, n_knots: usize) -> Result<Knots, FitError> {
+        let h = 0.95 * (hi - lo) / (n_knots - 1) as f64;
+        // a relative tolerance keeps a multiple that lands on the bound despite rounding
+        let k_lo = (0.95 * lo / h - 1e-9).ceil() as i64;
+        let k_hi = (0.95 * hi / h + 1e-9).floor() as i64;
+        if k_hi - k_lo < 1 {
+            return Err(FitError::Knots(format!(
+                "fewer than two multiples of h = {h} in [{}, {}]",
+                0.95 * lo,
+                0.95 * hi
+            )));
+        }
+        let t: Vec<f64> = (k_lo..=k_hi).map(|k| k as f64 * h).collect();
+        Ok(Knots { t, h, k_lo, k_hi })
+    }
+
+    /// Step 3's i_min: the knot at 0 ([`MinimumAt::Zero`]; an error when there is none, the samples spanning
+    /// [lo, hi]) or the knot with the smallest value `p` ([`MinimumAt::Argmin`]).
+    fn minimum(&self, rule: MinimumAt, p: &[f64], lo: f64, hi: f64) -> Result<usize, FitError> {
+        Ok(match rule {
+            MinimumAt::Zero => {
+                if self.k_lo > 0 || self.k_hi < 0 {
+                    return Err(FitError::Knots(format!(
+                        "no knot at 0: the samples span [{lo}, {hi}]"
+                    )));
+                }
+                (-self.k_lo) as usize
+            }
+            MinimumAt::Argmin => (0..self.t.len()).fold(0, |b, i| if p[i] < p[b] { i } else { b }),
+        })
+    }
+}
+
+/// Step 2's slopes at the knots `t`: the MLS of the sampled stresses (its odd part for s_a) when
+/// [`SlopeSource::Stress`], else central differences of g with step `d`.
+fn knot_slopes(
+    g: &Smoothed,
+    t: &[f64],
+    d: f64,
+    (x, psi, stress): (&[f64], &[f64], Option<&[f64]>),
+    opts: &Fit1DOptions,
+) -> Result<Vec<f64>, FitError> {
+    Ok(match (opts.slopes, stress) {
         (SlopeSource::Stress, Some(st)) => {
             let (sx, sy): (Vec<f64>, Vec<f64>) = (0..x.len())
                 .filter(|&i| x[i].is_finite() && psi[i].is_finite() && st[i].is_finite())
@@ -216,30 +252,23 @@ pub fn fit1d_with_stress(
         }
         _ => t
             .iter()
-            .map(|&u| (g(u + d) - g(u - d)) / (2.0 * d))
+            .map(|&u| (g.g(u + d) - g.g(u - d)) / (2.0 * d))
             .collect(),
-    };
-    if p.iter().chain(&m).any(|v| !v.is_finite()) {
-        return Err(FitError::BadOption(
-            "the MLS curve overflowed (Ψ too large for symexp)".into(),
-        ));
-    }
-    let n = t.len();
+    })
+}
 
-    // step 3: quasi-convexify outward from i_min
-    let i_min = match opts.minimum {
-        MinimumAt::Zero => {
-            if k_lo > 0 || k_hi < 0 {
-                return Err(FitError::Knots(format!(
-                    "no knot at 0: the samples span [{lo}, {hi}]"
-                )));
-            }
-            (-k_lo) as usize
-        }
-        MinimumAt::Argmin => (0..n).fold(0, |b, i| if p[i] < p[b] { i } else { b }),
-    };
-    let pmin = opts.min_slope;
-    if opts.minimum == MinimumAt::Zero {
+/// Step 3: quasi-convexify outward from i_min, p_{i+1} ≥ pᵢ + (t_{i+1} − tᵢ) pˣ_min and pˣᵢ ≥ pˣ_min on the
+/// right, mirrored on the left; the slope at i_min is set to 0 when `flat_minimum` (the in-plane strains).
+fn quasi_convexify(
+    t: &[f64],
+    p: &mut [f64],
+    m: &mut [f64],
+    i_min: usize,
+    pmin: f64,
+    flat_minimum: bool,
+) {
+    let n = t.len();
+    if flat_minimum {
         m[i_min] = 0.0;
     }
     for i in i_min + 1..n {
@@ -250,12 +279,14 @@ pub fn fit1d_with_stress(
         p[i] = p[i].max(p[i + 1] + (t[i + 1] - t[i]) * pmin);
         m[i] = m[i].min(-pmin);
     }
+}
 
-    // step 5 (before 4, which never changes a slope's sign or lowers |slope| below 3 pˣ_min): end slopes rise outward
+/// Steps 5 and 4 (5 first: 4 never changes a slope's sign or lowers |slope| below 3 pˣ_min): the end slopes rise
+/// outward, then Fritsch–Carlson, 0 ≤ α, β ≤ 3 on every cell, sides of i_min separately.
+fn limit_slopes(t: &[f64], p: &[f64], m: &mut [f64], pmin: f64) {
+    let n = t.len();
     m[n - 1] = m[n - 1].max(pmin);
     m[0] = m[0].min(-pmin);
-
-    // step 4: Fritsch–Carlson, 0 ≤ α, β ≤ 3 on every cell, sides of i_min separately
     for c in 0..n - 1 {
         let secant = (p[c + 1] - p[c]) / (t[c + 1] - t[c]);
         let cap = 3.0 * secant.abs();
@@ -266,10 +297,11 @@ pub fn fit1d_with_stress(
             }
         }
     }
+}
 
-    // step 6: residual form
-    let spline = Hermite1D::new(t, p, m);
-    // at the knot 0 (always there for in-plane strains) take its value exactly, else evaluate (extrapolating)
+/// Step 6: the spline minus its value f(0), and f(0) (taken exactly at the knot 0, always there for in-plane
+/// strains, else evaluated, extrapolating).
+fn residual_form(spline: Hermite1D) -> (Hermite1D, f64) {
     let offset = match spline.t.iter().position(|&v| v == 0.0) {
         Some(i) => spline.p[i],
         None => spline.eval2(0.0)[0],
@@ -277,7 +309,70 @@ pub fn fit1d_with_stress(
     let t = spline.t.clone();
     let p: Vec<f64> = spline.p.iter().map(|v| v - offset).collect();
     let m = spline.m.clone();
-    let spline = Hermite1D::new(t, p, m);
+    (Hermite1D::new(t, p, m), offset)
+}
+
+/// [`fit1d`] with the sampled stresses dΨ/dX (same length as `x`; non-finite entries are dropped with their
+/// sample), used for the slopes when `opts.slopes` is [`SlopeSource::Stress`]: pˣ = MLS(t | X, dΨ/dX), the odd part
+/// ½(MLS(t) − MLS(−t)) for s_a. An error when stresses are asked for but not given.
+pub fn fit1d_with_stress(
+    x: &[f64],
+    psi: &[f64],
+    stress: Option<&[f64]>,
+    opts: &Fit1DOptions,
+) -> Result<Fit1D, FitError> {
+    check_inputs(x, psi, stress, opts)?;
+    let (xs, ys): (Vec<f64>, Vec<f64>) = x
+        .iter()
+        .zip(psi)
+        .filter(|(a, b)| a.is_finite() && b.is_finite())
+        .map(|(&a, &b)| (a, b))
+        .unzip();
+    let n_excluded = x.len() - xs.len();
+
+    // step 1: g = symexp ∘ MLS ∘ symlog
+    let g = Smoothed::new(&xs, &ys, opts)?;
+
+    // step 2: knots at multiples of h inside [0.95 min X, 0.95 max X], p = g(t), slopes
+    let (lo, hi) = xs
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
+    let knots = Knots::new(lo, hi, opts.n_knots)?;
+    let curve: Vec<[f64; 2]> = (0..=200)
+        .map(|i| {
+            let u = lo + (hi - lo) * i as f64 / 200.0;
+            [u, g.g(u)]
+        })
+        .collect();
+    let t = knots.t.clone();
+    let mut p: Vec<f64> = t.iter().map(|&u| g.g(u)).collect();
+    let d = opts.fd_step * knots.h;
+    let mut m = knot_slopes(&g, &t, d, (x, psi, stress), opts)?;
+    if p.iter().chain(&m).any(|v| !v.is_finite()) {
+        return Err(FitError::BadOption(
+            "the MLS curve overflowed (Ψ too large for symexp)".into(),
+        ));
+    }
+
+    // step 3: quasi-convexify outward from i_min
+    let i_min = knots.minimum(opts.minimum, &p, lo, hi)?;
+    let pmin = opts.min_slope;
+    quasi_convexify(
+        &t,
+        &mut p,
+        &mut m,
+        i_min,
+        pmin,
+        opts.minimum == MinimumAt::Zero,
+    );
+
+    // steps 5 and 4: end slopes, Fritsch–Carlson
+    limit_slopes(&t, &p, &mut m, pmin);
+
+    // step 6: residual form
+    let (spline, offset) = residual_form(Hermite1D::new(t, p, m));
 
     // report
     let mut err = super::RelError::default();

@@ -37,10 +37,9 @@
 //! 8. Bounded extrapolation (our addition): the residual's slope across the boundary of the knot box is set to 0
 //!    (pˣ on the first and last knot column, pʸ on the first and last row), so r continues as a constant beyond
 //!    the sampled box and only the 1D terms, which rise outward, extrapolate. Without it the linear continuation
-//!    of r, the difference of two fits' boundary slopes, can fall faster than the 1D terms rise: on the generated
-//!    stockinette with the quick plan ψ reached −186 J/m² at (s_x, s_y, II₀₀) = (1.95, −0.5, −1848 m⁻¹), and a
-//!    drape fell into that well. The changed slopes only reshape the boundary patches, which the report's errors
-//!    include.
+//!    of r, the difference of two fits' boundary slopes, can fall faster than the 1D terms rise, and ψ gets a well
+//!    of negative energy beyond the sampled box that a simulation can fall into. The changed slopes only reshape
+//!    the boundary patches, which the report's errors include.
 //!
 //! The unconverted spline f of step 5 is returned too ([`Fit2D::full`]): its errors against the samples are the
 //! fit's own quality; the material uses the residual.
@@ -263,6 +262,368 @@ impl Grid {
     }
 }
 
+/// The minimum knot of step 3 (i_min along u, j_min along v) and the knot v = 0 (j0), about which step 6 takes
+/// the residual (i_min is the knot u = 0).
+struct Minimum {
+    i: usize,
+    j: usize,
+    j0: usize,
+}
+
+/// What the patch fixes of step 5 needed: rounds of twist halving, rounds of cross-slope shrinking, and the
+/// patches still failing the check.
+#[derive(Default)]
+struct PatchRounds {
+    twist: usize,
+    slope: usize,
+    nonmonotone: usize,
+}
+
+/// Step 1: g(u, v) = symexp(MLS(u, v | X, Y, symlog Ψ)), symmetrised in the axes that are s_a.
+struct Smoothed {
+    mls: Mls2D,
+    eps: f64,
+    symmetric: [bool; 2],
+}
+
+impl Smoothed {
+    fn new(xs: &[f64], ys: &[f64], fs: &[f64], opts: &Fit2DOptions) -> Result<Self, FitError> {
+        let (eps, logs) = symlog_samples(fs, opts.eps_rel);
+        let mls = Mls2D::new(xs, ys, &logs, opts.bandwidth_factor)?;
+        Ok(Smoothed {
+            mls,
+            eps,
+            symmetric: opts.symmetric,
+        })
+    }
+
+    fn g(&self, u: f64, v: f64) -> f64 {
+        let [su, sv] = self.symmetric;
+        symexp(self.mls.eval_symmetric(u, v, su, sv), self.eps)
+    }
+}
+
+/// The samples where x, y and Ψ are all finite, in their order.
+fn usable_samples(x: &[f64], y: &[f64], psi: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let mut xs = Vec::new();
+    let mut ys = Vec::new();
+    let mut fs = Vec::new();
+    for i in 0..psi.len() {
+        if x[i].is_finite() && y[i].is_finite() && psi[i].is_finite() {
+            xs.push(x[i]);
+            ys.push(y[i]);
+            fs.push(psi[i]);
+        }
+    }
+    (xs, ys, fs)
+}
+
+/// The knot indices of a line of `n` knots in the order step 3 visits them: `c`, then outward to the right, then
+/// outward to the left.
+fn outward(n: usize, c: usize) -> Vec<usize> {
+    let mut o = vec![c];
+    o.extend(c + 1..n);
+    o.extend((0..c).rev());
+    o
+}
+
+impl Grid {
+    /// Step 2: the knots of both axes over the samples' ranges, p = g at the knots and pˣ, pʸ, pˣʸ by central
+    /// differences of g (step `fd_step` × the smallest knot spacing of the axis). An error when g is not finite
+    /// at a knot.
+    fn sample(g: &Smoothed, xs: &[f64], ys: &[f64], opts: &Fit2DOptions) -> Result<Grid, FitError> {
+        let range = |d: &[f64]| {
+            d.iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+                    (l.min(v), h.max(v))
+                })
+        };
+        let (xl, xh) = range(xs);
+        let (yl, yh) = range(ys);
+        let tu = axis_knots(xl, xh, opts.n_knots[0], opts.extent)?;
+        let tv = axis_knots(yl, yh, opts.n_knots[1], opts.extent)?;
+        let (nu, nv) = (tu.len(), tv.len());
+        let min_gap = |t: &[f64]| {
+            t.windows(2)
+                .map(|w| w[1] - w[0])
+                .fold(f64::INFINITY, f64::min)
+        };
+        let du = opts.fd_step * min_gap(&tu);
+        let dv = opts.fd_step * min_gap(&tv);
+        let mut grid = Grid {
+            p: vec![0.0; nu * nv],
+            mu: vec![0.0; nu * nv],
+            mv: vec![0.0; nu * nv],
+            muv: vec![0.0; nu * nv],
+            tu,
+            tv,
+        };
+        let g = |u: f64, v: f64| g.g(u, v);
+        for j in 0..nv {
+            for i in 0..nu {
+                let (u, v) = (grid.tu[i], grid.tv[j]);
+                let k = grid.at(i, j);
+                grid.p[k] = g(u, v);
+                grid.mu[k] = (g(u + du, v) - g(u - du, v)) / (2.0 * du);
+                grid.mv[k] = (g(u, v + dv) - g(u, v - dv)) / (2.0 * dv);
+                grid.muv[k] = (g(u + du, v + dv) - g(u + du, v - dv) - g(u - du, v + dv)
+                    + g(u - du, v - dv))
+                    / (4.0 * du * dv);
+            }
+        }
+        if [&grid.p, &grid.mu, &grid.mv, &grid.muv]
+            .iter()
+            .any(|a| a.iter().any(|v| !v.is_finite()))
+        {
+            return Err(FitError::BadOption(
+                "the MLS surface is not finite at the knots (Ψ too large for symexp, or too few samples near a knot)"
+                    .into(),
+            ));
+        }
+        Ok(grid)
+    }
+
+    /// Step 3's minimum knot: i_min = the knot u = 0; j_min = the knot v = 0 ([`MinimumAt::Zero`]) or argmin_j
+    /// p(0, v_j) ([`MinimumAt::Argmin`]).
+    fn minimum(&self, rule: MinimumAt) -> Minimum {
+        let nv = self.tv.len();
+        let i_min = self.tu.iter().position(|&t| t == 0.0).unwrap_or(0);
+        let j0 = self.tv.iter().position(|&t| t == 0.0).unwrap_or(0);
+        let j_min = match rule {
+            MinimumAt::Zero => j0,
+            MinimumAt::Argmin => (0..nv).fold(0, |b, j| {
+                if self.p[self.at(i_min, j)] < self.p[self.at(i_min, b)] {
+                    j
+                } else {
+                    b
+                }
+            }),
+        };
+        Minimum {
+            i: i_min,
+            j: j_min,
+            j0,
+        }
+    }
+
+    /// Step 3: rows outward from j_min, each row outward from i_min, every value raised to ≥ its inner neighbours
+    /// along the row and the column plus their distance × pˣ_min; slopes pointing away from the minimum are at
+    /// least pˣ_min.
+    fn quasi_convexify(&mut self, min: &Minimum, pmin: f64) {
+        let (i_min, j_min) = (min.i, min.j);
+        let (nu, nv) = (self.tu.len(), self.tv.len());
+        for &j in &outward(nv, j_min) {
+            for &i in &outward(nu, i_min) {
+                let k = self.at(i, j);
+                let mut v = self.p[k];
+                if i != i_min {
+                    let ii = if i > i_min { i - 1 } else { i + 1 };
+                    v = v.max(self.p[self.at(ii, j)] + (self.tu[i] - self.tu[ii]).abs() * pmin);
+                    self.mu[k] = if i > i_min {
+                        self.mu[k].max(pmin)
+                    } else {
+                        self.mu[k].min(-pmin)
+                    };
+                }
+                if j != j_min {
+                    let jj = if j > j_min { j - 1 } else { j + 1 };
+                    v = v.max(self.p[self.at(i, jj)] + (self.tv[j] - self.tv[jj]).abs() * pmin);
+                    self.mv[k] = if j > j_min {
+                        self.mv[k].max(pmin)
+                    } else {
+                        self.mv[k].min(-pmin)
+                    };
+                }
+                self.p[k] = v;
+            }
+        }
+    }
+
+    /// Step 4: boundary pˣ (first/last column) clamped to ≤ −pˣ_min / ≥ pˣ_min, boundary pʸ likewise, pˣʸ = 0 on
+    /// the boundary.
+    fn clamp_boundary(&mut self, pmin: f64) {
+        let (nu, nv) = (self.tu.len(), self.tv.len());
+        for j in 0..nv {
+            let (a, b) = (self.at(0, j), self.at(nu - 1, j));
+            self.mu[a] = self.mu[a].min(-pmin);
+            self.mu[b] = self.mu[b].max(pmin);
+        }
+        for i in 0..nu {
+            let (a, b) = (self.at(i, 0), self.at(i, nv - 1));
+            self.mv[a] = self.mv[a].min(-pmin);
+            self.mv[b] = self.mv[b].max(pmin);
+        }
+        for j in 0..nv {
+            for i in 0..nu {
+                if i == 0 || j == 0 || i == nu - 1 || j == nv - 1 {
+                    let k = self.at(i, j);
+                    self.muv[k] = 0.0;
+                }
+            }
+        }
+    }
+
+    /// Step 5, grid lines: Fritsch–Carlson limits ([`limit_line`]) on pˣ along every row and on pʸ along every
+    /// column; `mi`, `mj` are the minimum knots whose slopes keep their sign.
+    fn limit_lines(&mut self, mi: Option<usize>, mj: Option<usize>) {
+        let (nu, nv) = (self.tu.len(), self.tv.len());
+        for j in 0..nv {
+            let ks: Vec<usize> = (0..nu).map(|i| self.at(i, j)).collect();
+            let p: Vec<f64> = ks.iter().map(|&k| self.p[k]).collect();
+            let mut m: Vec<f64> = ks.iter().map(|&k| self.mu[k]).collect();
+            limit_line(&self.tu, &p, &mut m, mi);
+            for (&k, v) in ks.iter().zip(m) {
+                self.mu[k] = v;
+            }
+        }
+        for i in 0..nu {
+            let ks: Vec<usize> = (0..nv).map(|j| self.at(i, j)).collect();
+            let p: Vec<f64> = ks.iter().map(|&k| self.p[k]).collect();
+            let mut m: Vec<f64> = ks.iter().map(|&k| self.mv[k]).collect();
+            limit_line(&self.tv, &p, &mut m, mj);
+            for (&k, v) in ks.iter().zip(m) {
+                self.mv[k] = v;
+            }
+        }
+    }
+
+    /// The four corners (i, j, index) of patch `(ci, cj)`.
+    fn corners(&self, (ci, cj): (usize, usize)) -> [(usize, usize, usize); 4] {
+        [
+            (ci, cj, self.at(ci, cj)),
+            (ci + 1, cj, self.at(ci + 1, cj)),
+            (ci, cj + 1, self.at(ci, cj + 1)),
+            (ci + 1, cj + 1, self.at(ci + 1, cj + 1)),
+        ]
+    }
+
+    /// Step 5, patch interiors: halve the twists at the corners of failing patches (up to 40 rounds), then, when
+    /// `strict`, shrink their cross slopes (up to 60 rounds).
+    fn monotone_patches(&mut self, min: &Minimum, pmin: f64, strict: bool) -> PatchRounds {
+        let mut rounds = PatchRounds::default();
+        let mut failing = self.failing_patches(min.i, min.j);
+        while !failing.is_empty() && rounds.twist < 40 {
+            rounds.twist += 1;
+            let mut seen = std::collections::HashSet::new();
+            for f in &failing {
+                for (_, _, k) in self.corners(f.cell) {
+                    if seen.insert(k) {
+                        self.muv[k] *= 0.5;
+                    }
+                }
+            }
+            failing = self.failing_patches(min.i, min.j);
+        }
+        while strict && !failing.is_empty() && rounds.slope < 60 {
+            rounds.slope += 1;
+            self.shrink_cross_slopes(&failing, min, pmin);
+            failing = self.failing_patches(min.i, min.j);
+        }
+        rounds.nonmonotone = failing.len();
+        rounds
+    }
+
+    /// One round of cross-slope shrinking. A twist-free patch can still change monotonicity in u when pʸ differs
+    /// strongly between its corners (the ∂f/∂u of the patch contains hv k_j(t) ∂_u H[pʸ]); shrinking |pʸ| towards
+    /// pˣ_min (keeping its sign, so the columns stay monotone and Fritsch–Carlson's box still holds) removes that
+    /// term in the limit, and likewise |pˣ| for a failure along v. The corners' twists are set to 0.
+    fn shrink_cross_slopes(&mut self, failing: &[Failing], min: &Minimum, pmin: f64) {
+        let mut seen = std::collections::HashSet::new();
+        for f in failing {
+            for (i, j, k) in self.corners(f.cell) {
+                if !seen.insert(k) {
+                    continue;
+                }
+                self.muv[k] = 0.0;
+                let shrink = |m: f64, free: bool| {
+                    if free {
+                        0.5 * m
+                    } else {
+                        (0.5 * m.abs()).max(pmin).copysign(m)
+                    }
+                };
+                if f.along_u {
+                    self.mv[k] = shrink(self.mv[k], j == min.j);
+                }
+                if f.along_v {
+                    self.mu[k] = shrink(self.mu[k], i == min.i);
+                }
+            }
+        }
+    }
+
+    /// Step 6: the residual r = f(u, v) − f(u, 0) − f(0, v) + f(0, 0) about the knots u = 0 (`i0`) and v = 0
+    /// (`j0`), with exact zeros on both axes.
+    fn residual(&self, i0: usize, j0: usize) -> Grid {
+        let (nu, nv) = (self.tu.len(), self.tv.len());
+        let mut r = Grid {
+            tu: self.tu.clone(),
+            tv: self.tv.clone(),
+            p: vec![0.0; nu * nv],
+            mu: vec![0.0; nu * nv],
+            mv: vec![0.0; nu * nv],
+            muv: self.muv.clone(),
+        };
+        for j in 0..nv {
+            for i in 0..nu {
+                let k = self.at(i, j);
+                let (kx, ky, k00) = (self.at(i, j0), self.at(i0, j), self.at(i0, j0));
+                r.p[k] = self.p[k] - self.p[kx] - self.p[ky] + self.p[k00];
+                r.mu[k] = self.mu[k] - self.mu[kx];
+                r.mv[k] = self.mv[k] - self.mv[ky];
+            }
+        }
+        // exact zeros on the axes (the formulas above give them up to rounding only when p(0,0) ≠ 0)
+        for i in 0..nu {
+            let k = r.at(i, j0);
+            r.p[k] = 0.0;
+            r.mu[k] = 0.0;
+        }
+        for j in 0..nv {
+            let k = r.at(i0, j);
+            r.p[k] = 0.0;
+            r.mv[k] = 0.0;
+        }
+        r
+    }
+
+    /// Step 7: every knot with a stretch coordinate ≤ 0 gets p = pˣ = pʸ = pˣʸ = 0.
+    fn zero_compression(&mut self, stretch: [bool; 2]) {
+        let (nu, nv) = (self.tu.len(), self.tv.len());
+        for j in 0..nv {
+            for i in 0..nu {
+                if (stretch[0] && self.tu[i] <= 0.0) || (stretch[1] && self.tv[j] <= 0.0) {
+                    let k = self.at(i, j);
+                    self.p[k] = 0.0;
+                    self.mu[k] = 0.0;
+                    self.mv[k] = 0.0;
+                    self.muv[k] = 0.0;
+                }
+            }
+        }
+    }
+
+    /// Step 8: zero slope across the boundary of the knot box (pˣ on the first and last column, pʸ on the first and
+    /// last row, pˣʸ on all four sides), so the residual stays constant beyond it.
+    fn bound_extrapolation(&mut self) {
+        let (nu, nv) = (self.tu.len(), self.tv.len());
+        for j in 0..nv {
+            for i in [0, nu - 1] {
+                let k = self.at(i, j);
+                self.mu[k] = 0.0;
+                self.muv[k] = 0.0;
+            }
+        }
+        for i in 0..nu {
+            for j in [0, nv - 1] {
+                let k = self.at(i, j);
+                self.mv[k] = 0.0;
+                self.muv[k] = 0.0;
+            }
+        }
+    }
+}
+
 /// FIT2D on samples `x`, `y` (normalised strains) and `psi`. Samples where any of the three is not finite are
 /// excluded and counted. Errors: length mismatch, too few usable samples, invalid options, or data that do not
 /// reach 0 on an axis.
@@ -274,227 +635,34 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
         });
     }
     check_options(opts)?;
-    let mut xs = Vec::new();
-    let mut ys = Vec::new();
-    let mut fs = Vec::new();
-    for i in 0..psi.len() {
-        if x[i].is_finite() && y[i].is_finite() && psi[i].is_finite() {
-            xs.push(x[i]);
-            ys.push(y[i]);
-            fs.push(psi[i]);
-        }
-    }
+    let (xs, ys, fs) = usable_samples(x, y, psi);
     let n_excluded = psi.len() - fs.len();
 
     // step 1
-    let (eps, logs) = symlog_samples(&fs, opts.eps_rel);
-    let mls = Mls2D::new(&xs, &ys, &logs, opts.bandwidth_factor)?;
-    let [su, sv] = opts.symmetric;
-    let g = |u: f64, v: f64| symexp(mls.eval_symmetric(u, v, su, sv), eps);
-
+    let g = Smoothed::new(&xs, &ys, &fs, opts)?;
     // step 2
-    let range = |d: &[f64]| {
-        d.iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
-                (l.min(v), h.max(v))
-            })
-    };
-    let (xl, xh) = range(&xs);
-    let (yl, yh) = range(&ys);
-    let tu = axis_knots(xl, xh, opts.n_knots[0], opts.extent)?;
-    let tv = axis_knots(yl, yh, opts.n_knots[1], opts.extent)?;
-    let (nu, nv) = (tu.len(), tv.len());
-    let min_gap = |t: &[f64]| {
-        t.windows(2)
-            .map(|w| w[1] - w[0])
-            .fold(f64::INFINITY, f64::min)
-    };
-    let du = opts.fd_step * min_gap(&tu);
-    let dv = opts.fd_step * min_gap(&tv);
-    let mut grid = Grid {
-        p: vec![0.0; nu * nv],
-        mu: vec![0.0; nu * nv],
-        mv: vec![0.0; nu * nv],
-        muv: vec![0.0; nu * nv],
-        tu,
-        tv,
-    };
-    for j in 0..nv {
-        for i in 0..nu {
-            let (u, v) = (grid.tu[i], grid.tv[j]);
-            let k = grid.at(i, j);
-            grid.p[k] = g(u, v);
-            grid.mu[k] = (g(u + du, v) - g(u - du, v)) / (2.0 * du);
-            grid.mv[k] = (g(u, v + dv) - g(u, v - dv)) / (2.0 * dv);
-            grid.muv[k] = (g(u + du, v + dv) - g(u + du, v - dv) - g(u - du, v + dv)
-                + g(u - du, v - dv))
-                / (4.0 * du * dv);
-        }
-    }
-    if [&grid.p, &grid.mu, &grid.mv, &grid.muv]
-        .iter()
-        .any(|a| a.iter().any(|v| !v.is_finite()))
-    {
-        return Err(FitError::BadOption(
-            "the MLS surface is not finite at the knots (Ψ too large for symexp, or too few samples near a knot)"
-                .into(),
-        ));
-    }
-
+    let mut grid = Grid::sample(&g, &xs, &ys, opts)?;
     // step 3
-    let i_min = grid.tu.iter().position(|&t| t == 0.0).unwrap_or(0);
-    let j0 = grid.tv.iter().position(|&t| t == 0.0).unwrap_or(0);
-    let j_min = match opts.minimum_v {
-        MinimumAt::Zero => j0,
-        MinimumAt::Argmin => (0..nv).fold(0, |b, j| {
-            if grid.p[grid.at(i_min, j)] < grid.p[grid.at(i_min, b)] {
-                j
-            } else {
-                b
-            }
-        }),
-    };
+    let min = grid.minimum(opts.minimum_v);
     let pmin = opts.min_slope;
-    let outward = |n: usize, c: usize| -> Vec<usize> {
-        let mut o = vec![c];
-        o.extend(c + 1..n);
-        o.extend((0..c).rev());
-        o
-    };
     if opts.quasi_convex {
-        for &j in &outward(nv, j_min) {
-            for &i in &outward(nu, i_min) {
-                let k = grid.at(i, j);
-                let mut v = grid.p[k];
-                if i != i_min {
-                    let ii = if i > i_min { i - 1 } else { i + 1 };
-                    v = v.max(grid.p[grid.at(ii, j)] + (grid.tu[i] - grid.tu[ii]).abs() * pmin);
-                    grid.mu[k] = if i > i_min {
-                        grid.mu[k].max(pmin)
-                    } else {
-                        grid.mu[k].min(-pmin)
-                    };
-                }
-                if j != j_min {
-                    let jj = if j > j_min { j - 1 } else { j + 1 };
-                    v = v.max(grid.p[grid.at(i, jj)] + (grid.tv[j] - grid.tv[jj]).abs() * pmin);
-                    grid.mv[k] = if j > j_min {
-                        grid.mv[k].max(pmin)
-                    } else {
-                        grid.mv[k].min(-pmin)
-                    };
-                }
-                grid.p[k] = v;
-            }
-        }
+        grid.quasi_convexify(&min, pmin);
     }
-
     // step 4 (applied again after step 5 so the Fritsch–Carlson zeroing of (s_x, s_y) cannot undo it)
-    let clamp_boundary = |grid: &mut Grid| {
-        for j in 0..nv {
-            let (a, b) = (grid.at(0, j), grid.at(nu - 1, j));
-            grid.mu[a] = grid.mu[a].min(-pmin);
-            grid.mu[b] = grid.mu[b].max(pmin);
-        }
-        for i in 0..nu {
-            let (a, b) = (grid.at(i, 0), grid.at(i, nv - 1));
-            grid.mv[a] = grid.mv[a].min(-pmin);
-            grid.mv[b] = grid.mv[b].max(pmin);
-        }
-        for j in 0..nv {
-            for i in 0..nu {
-                if i == 0 || j == 0 || i == nu - 1 || j == nv - 1 {
-                    let k = grid.at(i, j);
-                    grid.muv[k] = 0.0;
-                }
-            }
-        }
-    };
-    clamp_boundary(&mut grid);
-
-    // step 5: Fritsch–Carlson along rows and columns
+    grid.clamp_boundary(pmin);
+    // step 5: Fritsch–Carlson along rows and columns, then the patches
     let (mi, mj) = if opts.quasi_convex {
-        (Some(i_min), Some(j_min))
+        (Some(min.i), Some(min.j))
     } else {
         (None, None)
     };
-    for j in 0..nv {
-        let ks: Vec<usize> = (0..nu).map(|i| grid.at(i, j)).collect();
-        let p: Vec<f64> = ks.iter().map(|&k| grid.p[k]).collect();
-        let mut m: Vec<f64> = ks.iter().map(|&k| grid.mu[k]).collect();
-        limit_line(&grid.tu, &p, &mut m, mi);
-        for (&k, v) in ks.iter().zip(m) {
-            grid.mu[k] = v;
-        }
-    }
-    for i in 0..nu {
-        let ks: Vec<usize> = (0..nv).map(|j| grid.at(i, j)).collect();
-        let p: Vec<f64> = ks.iter().map(|&k| grid.p[k]).collect();
-        let mut m: Vec<f64> = ks.iter().map(|&k| grid.mv[k]).collect();
-        limit_line(&grid.tv, &p, &mut m, mj);
-        for (&k, v) in ks.iter().zip(m) {
-            grid.mv[k] = v;
-        }
-    }
-    clamp_boundary(&mut grid);
-    // twists: halve at the corners of failing patches, then zero; then shrink the cross slopes (see below)
-    let mut twist_rounds = 0;
-    let mut slope_rounds = 0;
-    let mut nonmonotone_patches = 0;
-    if opts.quasi_convex {
-        let corners = |grid: &Grid, (ci, cj): (usize, usize)| {
-            [
-                (ci, cj, grid.at(ci, cj)),
-                (ci + 1, cj, grid.at(ci + 1, cj)),
-                (ci, cj + 1, grid.at(ci, cj + 1)),
-                (ci + 1, cj + 1, grid.at(ci + 1, cj + 1)),
-            ]
-        };
-        let mut failing = grid.failing_patches(i_min, j_min);
-        while !failing.is_empty() && twist_rounds < 40 {
-            twist_rounds += 1;
-            let mut seen = std::collections::HashSet::new();
-            for f in &failing {
-                for (_, _, k) in corners(&grid, f.cell) {
-                    if seen.insert(k) {
-                        grid.muv[k] *= 0.5;
-                    }
-                }
-            }
-            failing = grid.failing_patches(i_min, j_min);
-        }
-        // A twist-free patch can still change monotonicity in u when pʸ differs strongly between its corners (the
-        // ∂f/∂u of the patch contains hv k_j(t) ∂_u H[pʸ]); shrinking |pʸ| towards pˣ_min (keeping its sign, so the
-        // columns stay monotone and Fritsch–Carlson's box still holds) removes that term in the limit, and
-        // likewise |pˣ| for a failure along v.
-        while opts.strict_patches && !failing.is_empty() && slope_rounds < 60 {
-            slope_rounds += 1;
-            let mut seen = std::collections::HashSet::new();
-            for f in &failing {
-                for (i, j, k) in corners(&grid, f.cell) {
-                    if !seen.insert(k) {
-                        continue;
-                    }
-                    grid.muv[k] = 0.0;
-                    let shrink = |m: f64, free: bool| {
-                        if free {
-                            0.5 * m
-                        } else {
-                            (0.5 * m.abs()).max(pmin).copysign(m)
-                        }
-                    };
-                    if f.along_u {
-                        grid.mv[k] = shrink(grid.mv[k], j == j_min);
-                    }
-                    if f.along_v {
-                        grid.mu[k] = shrink(grid.mu[k], i == i_min);
-                    }
-                }
-            }
-            failing = grid.failing_patches(i_min, j_min);
-        }
-        nonmonotone_patches = failing.len();
-    }
+    grid.limit_lines(mi, mj);
+    grid.clamp_boundary(pmin);
+    let rounds = if opts.quasi_convex {
+        grid.monotone_patches(&min, pmin, opts.strict_patches)
+    } else {
+        PatchRounds::default()
+    };
     let full = grid.spline();
 
     // report on the unconverted spline
@@ -503,78 +671,25 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
         err.add(full.eval2(u, v)[0], f);
     }
 
-    // step 6: residual about the knots u = 0 (i0 = i_min) and v = 0 (j0)
-    let i0 = i_min;
-    let mut r = Grid {
-        tu: grid.tu.clone(),
-        tv: grid.tv.clone(),
-        p: vec![0.0; nu * nv],
-        mu: vec![0.0; nu * nv],
-        mv: vec![0.0; nu * nv],
-        muv: grid.muv.clone(),
-    };
-    for j in 0..nv {
-        for i in 0..nu {
-            let k = grid.at(i, j);
-            let (kx, ky, k00) = (grid.at(i, j0), grid.at(i0, j), grid.at(i0, j0));
-            r.p[k] = grid.p[k] - grid.p[kx] - grid.p[ky] + grid.p[k00];
-            r.mu[k] = grid.mu[k] - grid.mu[kx];
-            r.mv[k] = grid.mv[k] - grid.mv[ky];
-        }
-    }
-    // exact zeros on the axes (the formulas above give them up to rounding only when p(0,0) ≠ 0)
-    for i in 0..nu {
-        let k = r.at(i, j0);
-        r.p[k] = 0.0;
-        r.mu[k] = 0.0;
-    }
-    for j in 0..nv {
-        let k = r.at(i0, j);
-        r.p[k] = 0.0;
-        r.mv[k] = 0.0;
-    }
-
-    // step 7: zero-compression residual
+    // step 6
+    let mut r = grid.residual(min.i, min.j0);
+    // step 7
     if opts.quasi_convex {
-        for j in 0..nv {
-            for i in 0..nu {
-                if (opts.stretch[0] && r.tu[i] <= 0.0) || (opts.stretch[1] && r.tv[j] <= 0.0) {
-                    let k = r.at(i, j);
-                    r.p[k] = 0.0;
-                    r.mu[k] = 0.0;
-                    r.mv[k] = 0.0;
-                    r.muv[k] = 0.0;
-                }
-            }
-        }
+        r.zero_compression(opts.stretch);
     }
-
-    // step 8: the residual stays constant beyond the knot box
-    for j in 0..nv {
-        for i in [0, nu - 1] {
-            let k = r.at(i, j);
-            r.mu[k] = 0.0;
-            r.muv[k] = 0.0;
-        }
-    }
-    for i in 0..nu {
-        for j in [0, nv - 1] {
-            let k = r.at(i, j);
-            r.mv[k] = 0.0;
-            r.muv[k] = 0.0;
-        }
-    }
+    // step 8
+    r.bound_extrapolation();
 
     let report = Fit2DReport {
         n_samples: fs.len(),
         n_excluded,
         rms_rel: err.rms_rel(),
         max_rel: err.max_rel(),
-        i_min,
-        j_min,
-        twist_rounds,
-        slope_rounds,
-        nonmonotone_patches,
+        i_min: min.i,
+        j_min: min.j,
+        twist_rounds: rounds.twist,
+        slope_rounds: rounds.slope,
+        nonmonotone_patches: rounds.nonmonotone,
     };
     Ok(Fit2D {
         residual: r.spline(),

@@ -16,41 +16,24 @@ pub use fit1d::{
 pub use fit2d::{fit2d, Fit2D, Fit2DOptions, Fit2DReport};
 pub use mls::{Mls1D, Mls2D};
 pub use model::{fit_material, model_error, FitOptions, FitReport, MaterialFit, ModelError};
-
-use std::fmt;
+pub use plot::PlotError;
 
 /// Why a fit could not be made. Bad input is reported, never a panic.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum FitError {
     /// X and Ψ have different lengths
+    #[error("sample arrays differ in length: {x} abscissae, {psi} values")]
     LengthMismatch { x: usize, psi: usize },
     /// fewer usable (finite) samples or distinct abscissae than the method needs
+    #[error("too few usable samples: {usable} (need at least {needed} distinct finite ones)")]
     TooFewSamples { usable: usize, needed: usize },
     /// an option outside its valid range
+    #[error("invalid fit option: {0}")]
     BadOption(String),
     /// the knot rule left fewer than two knots, or the minimum knot is missing
+    #[error("knot placement failed: {0}")]
     Knots(String),
 }
-
-impl fmt::Display for FitError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            FitError::LengthMismatch { x, psi } => {
-                write!(
-                    f,
-                    "sample arrays differ in length: {x} abscissae, {psi} values"
-                )
-            }
-            FitError::TooFewSamples { usable, needed } => {
-                write!(f, "too few usable samples: {usable} (need at least {needed} distinct finite ones)")
-            }
-            FitError::BadOption(s) => write!(f, "invalid fit option: {s}"),
-            FitError::Knots(s) => write!(f, "knot placement failed: {s}"),
-        }
-    }
-}
-
-impl std::error::Error for FitError {}
 
 /// Relative errors of fitted values against data: √(Σ e²)/√(Σ y²) and max |e| / max |y| (absolute when the data
 /// are all 0), with the index of the largest |e|.

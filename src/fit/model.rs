@@ -22,7 +22,7 @@ use super::fit1d::{fit1d_with_stress, Fit1D, Fit1DOptions, MinimumAt, SlopeSourc
 use super::fit2d::{fit2d, Fit2D, Fit2DOptions};
 use super::FitError;
 use crate::material::{Material, Term1D, Term2D};
-use crate::sample::{Plan, Record};
+use crate::sample::{Plan, Record, Sample};
 use crate::strain::StrainComponent;
 use serde::Serialize;
 
@@ -208,6 +208,321 @@ pub fn model_error<'a>(
     }
 }
 
+/// The plan's records by sample index (later duplicates replace earlier ones; indices beyond the plan are
+/// dropped).
+struct ByIndex<'a> {
+    records: Vec<Option<&'a Record>>,
+}
+
+impl<'a> ByIndex<'a> {
+    /// Index `records` by their position in `plan`; a record whose id does not carry the plan's `hash` is an
+    /// error.
+    fn new(plan: &Plan, records: &'a [Record], hash: &str) -> Result<Self, FitError> {
+        let n = plan.len();
+        let mut by_index: Vec<Option<&Record>> = vec![None; n];
+        for r in records {
+            if !r.id.starts_with(hash) {
+                return Err(FitError::BadOption(format!(
+                    "sample {} does not belong to plan {hash} (pass the plan the samples were run with)",
+                    r.id
+                )));
+            }
+            if r.index < n {
+                by_index[r.index] = Some(r);
+            }
+        }
+        Ok(ByIndex { records: by_index })
+    }
+
+    /// The records present, in plan order.
+    fn present(&self) -> Vec<&'a Record> {
+        self.records.iter().flatten().copied().collect()
+    }
+
+    /// Ψ̄ of sample `i` (NaN when missing or failed).
+    fn psi(&self, i: usize) -> f64 {
+        self.records[i].and_then(|r| r.psi).unwrap_or(f64::NAN)
+    }
+
+    /// The stress dΨ̄/dX of sample `i` along strain `k` in normalised units X = z_k/σ (NaN when missing).
+    fn stress(&self, i: usize, k: usize, sigma: f64) -> f64 {
+        self.records[i]
+            .and_then(|r| r.stress)
+            .and_then(|s| s[k])
+            .map_or(f64::NAN, |d| d * sigma)
+    }
+
+    /// The records present in `range`.
+    fn in_range(&self, range: std::ops::Range<usize>) -> Vec<&'a Record> {
+        range.filter_map(|i| self.records[i]).collect::<Vec<_>>()
+    }
+}
+
+/// Strain scales σ_k = max |z_k| over the plan's samples (1 for a strain the plan never varies).
+fn strain_scales(samples: &[Sample]) -> [f64; 5] {
+    let mut sigma = [0.0f64; 5];
+    for s in samples {
+        for k in 0..5 {
+            sigma[k] = sigma[k].max(s.z[k].abs());
+        }
+    }
+    for v in &mut sigma {
+        if *v == 0.0 {
+            *v = 1.0;
+        }
+    }
+    sigma
+}
+
+/// FIT1D's options for strain `k`: symmetrised for s_a, minimum at 0 in-plane and at argmin p for bending.
+fn options_1d(k: usize, opts: &FitOptions) -> Fit1DOptions {
+    Fit1DOptions {
+        n_knots: opts.n_knots_1d,
+        bandwidth_factor: opts.bandwidth_factor,
+        eps_rel: opts.eps_rel,
+        min_slope: opts.min_slope,
+        symmetric: k == 1,
+        minimum: if k < 3 {
+            MinimumAt::Zero
+        } else {
+            MinimumAt::Argmin
+        },
+        fd_step: 1e-3,
+        slopes: opts.slopes,
+    }
+}
+
+/// The 1D terms f_k: FIT1D on every `thin_1d`-th sample of each strain's 1D range.
+fn fit_terms1d(
+    plan: &Plan,
+    samples: &[Sample],
+    by_index: &ByIndex,
+    sigma: [f64; 5],
+    opts: &FitOptions,
+) -> Result<Vec<(usize, Fit1D, TermData)>, FitError> {
+    let mut fits1d = Vec::new();
+    for k in 0..5 {
+        let range = plan.range_1d(k);
+        let idx: Vec<usize> = range
+            .clone()
+            .filter(|i| (i - range.start).is_multiple_of(opts.thin_1d.max(1)))
+            .collect();
+        let x: Vec<f64> = idx.iter().map(|&i| samples[i].z[k] / sigma[k]).collect();
+        let psi: Vec<f64> = idx.iter().map(|&i| by_index.psi(i)).collect();
+        let stress: Vec<f64> = idx
+            .iter()
+            .map(|&i| by_index.stress(i, k, sigma[k]))
+            .collect();
+        let o = options_1d(k, opts);
+        let fit = fit1d_with_stress(&x, &psi, Some(&stress), &o).map_err(|e| {
+            FitError::BadOption(format!(
+                "1D term {} ({}): {e}",
+                k,
+                StrainComponent::NAMES[k]
+            ))
+        })?;
+        fits1d.push((k, fit, TermData { x, y: vec![], psi }));
+    }
+    Ok(fits1d)
+}
+
+/// The constant f₀ and the strain of the sample it was taken from: Ψ̄ of the converged sample nearest z = 0 in
+/// normalised units, among the s_a range's samples when any of them converged (Ψ̄ is even in s_a, so its error is
+/// second order), else among all.
+fn constant_term(
+    plan: &Plan,
+    present: &[&Record],
+    sigma: [f64; 5],
+) -> Result<(f64, [f64; 5]), FitError> {
+    let sa_range = plan.range_1d(1);
+    let on_sa = present
+        .iter()
+        .any(|r| sa_range.contains(&r.index) && r.psi.is_some_and(f64::is_finite));
+    let nearest = present
+        .iter()
+        .filter(|r| r.psi.is_some_and(f64::is_finite) && (!on_sa || sa_range.contains(&r.index)))
+        .map(|r| {
+            let d: f64 = (0..5).map(|k| (r.z[k] / sigma[k]).powi(2)).sum();
+            (d, *r)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .ok_or(FitError::TooFewSamples {
+            usable: 0,
+            needed: 1,
+        })?;
+    Ok((nearest.1.psi.unwrap_or(0.0), nearest.1.z))
+}
+
+/// FIT2D's options for the pair (k0, k1), k0 < k1: (s_x, s_y) neither quasi-convexified nor zero-compressed, a
+/// stretch axis zero-compressed, an s_a axis symmetrised, a bending axis with its minimum at argmin and the
+/// bending pairs' knot count and extent.
+fn options_2d(k0: usize, k1: usize, opts: &FitOptions) -> Fit2DOptions {
+    let stretch = |k: usize| k == 0 || k == 2;
+    let bending = k1 >= 3;
+    Fit2DOptions {
+        n_knots: [if bending {
+            opts.n_knots_2d_bending
+        } else {
+            opts.n_knots_2d
+        }; 2],
+        extent: if bending {
+            opts.extent_2d_bending
+        } else {
+            opts.extent_2d
+        },
+        bandwidth_factor: opts.bandwidth_factor,
+        eps_rel: opts.eps_rel,
+        min_slope: opts.min_slope,
+        symmetric: [k0 == 1, k1 == 1],
+        quasi_convex: !(k0 == 0 && k1 == 2),
+        minimum_v: if k1 < 3 {
+            MinimumAt::Zero
+        } else {
+            MinimumAt::Argmin
+        },
+        stretch: [stretch(k0), stretch(k1)],
+        fd_step: 1e-3,
+        strict_patches: opts.strict_patches,
+    }
+}
+
+/// The 2D terms f_kl: FIT2D on each pair's grid, the pair's strains ordered k < l.
+fn fit_terms2d(
+    plan: &Plan,
+    samples: &[Sample],
+    by_index: &ByIndex,
+    sigma: [f64; 5],
+    opts: &FitOptions,
+) -> Result<Vec<(usize, usize, Fit2D, TermData)>, FitError> {
+    let mut fits2d = Vec::new();
+    for (p, [a, b]) in plan.pairs.iter().enumerate() {
+        let (ka, kb) = (a.index(), b.index());
+        let (k0, k1) = (ka.min(kb), ka.max(kb));
+        let idx: Vec<usize> = plan.range_2d(p).collect();
+        let x: Vec<f64> = idx.iter().map(|&i| samples[i].z[k0] / sigma[k0]).collect();
+        let y: Vec<f64> = idx.iter().map(|&i| samples[i].z[k1] / sigma[k1]).collect();
+        let psi: Vec<f64> = idx.iter().map(|&i| by_index.psi(i)).collect();
+        let o = options_2d(k0, k1, opts);
+        let fit = fit2d(&x, &y, &psi, &o).map_err(|e| {
+            FitError::BadOption(format!(
+                "2D term ({}, {}): {e}",
+                StrainComponent::NAMES[k0],
+                StrainComponent::NAMES[k1]
+            ))
+        })?;
+        fits2d.push((k0, k1, fit, TermData { x, y, psi }));
+    }
+    Ok(fits2d)
+}
+
+/// The material of the fitted terms (the 1D splines and the 2D residuals), without extra keys.
+fn assemble(
+    density: f64,
+    sigma: [f64; 5],
+    constant: f64,
+    fits1d: &[(usize, Fit1D, TermData)],
+    fits2d: &[(usize, usize, Fit2D, TermData)],
+) -> Material {
+    Material {
+        density,
+        strain_scale: sigma,
+        constant,
+        terms1d: fits1d
+            .iter()
+            .map(|(k, f, _)| Term1D {
+                strain: StrainComponent::ALL[*k],
+                spline: f.spline.clone(),
+            })
+            .collect(),
+        terms2d: fits2d
+            .iter()
+            .map(|(k0, k1, f, _)| Term2D {
+                strains: [StrainComponent::ALL[*k0], StrainComponent::ALL[*k1]],
+                spline: f.residual.clone(),
+            })
+            .collect(),
+        extra: serde_json::Map::new(),
+    }
+}
+
+/// The per-term reports: each fit's own quality and the whole model's errors on the term's samples.
+fn term_reports(
+    material: &Material,
+    plan: &Plan,
+    by_index: &ByIndex,
+    fits1d: &[(usize, Fit1D, TermData)],
+    fits2d: &[(usize, usize, Fit2D, TermData)],
+) -> (Vec<Term1DReport>, Vec<Term2DReport>) {
+    let terms1d: Vec<Term1DReport> = fits1d
+        .iter()
+        .map(|(k, f, _)| Term1DReport {
+            k: *k,
+            strain: StrainComponent::ALL[*k],
+            n_samples: f.report.n_samples,
+            n_excluded: f.report.n_excluded,
+            fit_rms_rel: f.report.rms_rel,
+            fit_max_rel: f.report.max_rel,
+            offset: f.offset,
+            i_min: f.report.i_min,
+            model: model_error(material, by_index.in_range(plan.range_1d(*k))),
+        })
+        .collect();
+    let terms2d: Vec<Term2DReport> = fits2d
+        .iter()
+        .enumerate()
+        .map(|(p, (k0, k1, f, _))| Term2DReport {
+            k0: *k0,
+            k1: *k1,
+            strains: [StrainComponent::ALL[*k0], StrainComponent::ALL[*k1]],
+            n_samples: f.report.n_samples,
+            n_excluded: f.report.n_excluded,
+            fit_rms_rel: f.report.rms_rel,
+            fit_max_rel: f.report.max_rel,
+            twist_rounds: f.report.twist_rounds,
+            slope_rounds: f.report.slope_rounds,
+            nonmonotone_patches: f.report.nonmonotone_patches,
+            model: model_error(material, by_index.in_range(plan.range_2d(p))),
+        })
+        .collect();
+    (terms1d, terms2d)
+}
+
+/// The material's `meta` block: `meta` completed with the plan hash, the fit options and the fit errors.
+fn meta_block(
+    mut meta: serde_json::Map<String, serde_json::Value>,
+    opts: &FitOptions,
+    report: &FitReport,
+) -> serde_json::Map<String, serde_json::Value> {
+    meta.insert("plan".into(), serde_json::json!(report.plan_hash));
+    meta.insert(
+        "fit options".into(),
+        serde_json::json!({
+            "n_knots_1d": opts.n_knots_1d, "n_knots_2d": opts.n_knots_2d, "extent_2d": opts.extent_2d,
+            "n_knots_2d_bending": opts.n_knots_2d_bending, "extent_2d_bending": opts.extent_2d_bending,
+            "min_slope": opts.min_slope, "bandwidth_factor": opts.bandwidth_factor, "eps_rel": opts.eps_rel,
+            "slopes": format!("{:?}", opts.slopes), "thin_1d": opts.thin_1d,
+            "strict_patches": opts.strict_patches,
+        }),
+    );
+    meta.insert(
+        "fit errors".into(),
+        serde_json::json!({
+            "samples": report.samples, "converged": report.converged,
+            "model_rms_rel": report.all.rms_rel, "model_max_rel": report.all.max_rel,
+            "constant_spread": report.constant_spread,
+            "holdout": report.holdout.as_ref().map(|h| serde_json::json!({
+                "samples": h.n_samples, "rms_rel": h.rms_rel, "max_rel": h.max_rel })),
+            "1D": report.terms1d.iter().map(|t| serde_json::json!({
+                "strain": t.strain, "rms_rel": t.model.rms_rel, "max_rel": t.model.max_rel,
+                "excluded": t.n_excluded })).collect::<Vec<_>>(),
+            "2D": report.terms2d.iter().map(|t| serde_json::json!({
+                "strains": t.strains, "rms_rel": t.model.rms_rel, "max_rel": t.model.max_rel,
+                "excluded": t.n_excluded, "nonmonotone_patches": t.nonmonotone_patches })).collect::<Vec<_>>(),
+        }),
+    );
+    meta
+}
+
 /// Fit a material (Algorithm C5) to the records of `plan` (other records are ignored; a record whose id does not
 /// carry the plan's hash is an error, as is a plan without 1D ranges). `density` is ρ_A (kg/m²); `meta` goes into
 /// the material's `meta` block, completed with the plan hash, the options and the fit errors.
@@ -227,212 +542,30 @@ pub fn fit_material(
         )));
     }
     let n = plan.len();
-    let mut by_index: Vec<Option<&Record>> = vec![None; n];
-    for r in records {
-        if !r.id.starts_with(&hash) {
-            return Err(FitError::BadOption(format!(
-                "sample {} does not belong to plan {hash} (pass the plan the samples were run with)",
-                r.id
-            )));
-        }
-        if r.index < n {
-            by_index[r.index] = Some(r);
-        }
-    }
-    let present: Vec<&Record> = by_index.iter().flatten().copied().collect();
+    let by_index = ByIndex::new(plan, records, &hash)?;
+    let present = by_index.present();
     let converged = present.iter().filter(|r| r.psi.is_some()).count();
-
-    // strain scales
     let samples = plan.samples();
-    let mut sigma = [0.0f64; 5];
-    for s in &samples {
-        for k in 0..5 {
-            sigma[k] = sigma[k].max(s.z[k].abs());
-        }
-    }
-    for v in &mut sigma {
-        if *v == 0.0 {
-            *v = 1.0;
-        }
-    }
-    let psi_of = |i: usize| by_index[i].and_then(|r| r.psi).unwrap_or(f64::NAN);
+    let sigma = strain_scales(&samples);
 
-    // 1D terms
-    let mut fits1d = Vec::new();
-    for k in 0..5 {
-        let range = plan.range_1d(k);
-        let idx: Vec<usize> = range
-            .clone()
-            .filter(|i| (i - range.start).is_multiple_of(opts.thin_1d.max(1)))
-            .collect();
-        let x: Vec<f64> = idx.iter().map(|&i| samples[i].z[k] / sigma[k]).collect();
-        let psi: Vec<f64> = idx.iter().map(|&i| psi_of(i)).collect();
-        let stress: Vec<f64> = idx
-            .iter()
-            .map(|&i| {
-                by_index[i]
-                    .and_then(|r| r.stress)
-                    .and_then(|s| s[k])
-                    .map_or(f64::NAN, |d| d * sigma[k])
-            })
-            .collect();
-        let o = Fit1DOptions {
-            n_knots: opts.n_knots_1d,
-            bandwidth_factor: opts.bandwidth_factor,
-            eps_rel: opts.eps_rel,
-            min_slope: opts.min_slope,
-            symmetric: k == 1,
-            minimum: if k < 3 {
-                MinimumAt::Zero
-            } else {
-                MinimumAt::Argmin
-            },
-            fd_step: 1e-3,
-            slopes: opts.slopes,
-        };
-        let fit = fit1d_with_stress(&x, &psi, Some(&stress), &o).map_err(|e| {
-            FitError::BadOption(format!(
-                "1D term {} ({}): {e}",
-                k,
-                StrainComponent::NAMES[k]
-            ))
-        })?;
-        fits1d.push((k, fit, TermData { x, y: vec![], psi }));
-    }
-    // prefer the s_a range (Ψ̄ is even in s_a, so its error is second order); any sample otherwise
-    let sa_range = plan.range_1d(1);
-    let on_sa = present
-        .iter()
-        .any(|r| sa_range.contains(&r.index) && r.psi.is_some_and(f64::is_finite));
-    let nearest = present
-        .iter()
-        .filter(|r| r.psi.is_some_and(f64::is_finite) && (!on_sa || sa_range.contains(&r.index)))
-        .map(|r| {
-            let d: f64 = (0..5).map(|k| (r.z[k] / sigma[k]).powi(2)).sum();
-            (d, *r)
-        })
-        .min_by(|a, b| a.0.total_cmp(&b.0))
-        .ok_or(FitError::TooFewSamples {
-            usable: 0,
-            needed: 1,
-        })?;
-    let constant = nearest.1.psi.unwrap_or(0.0);
-    let constant_at = nearest.1.z;
+    let fits1d = fit_terms1d(plan, &samples, &by_index, sigma, opts)?;
+    let (constant, constant_at) = constant_term(plan, &present, sigma)?;
     let spread = fits1d[..3]
         .iter()
         .map(|(_, f, _)| (f.offset - constant).abs())
         .fold(0.0f64, f64::max);
+    let fits2d = fit_terms2d(plan, &samples, &by_index, sigma, opts)?;
+    let mut material = assemble(density, sigma, constant, &fits1d, &fits2d);
 
-    // 2D terms
-    let mut fits2d = Vec::new();
-    for (p, [a, b]) in plan.pairs.iter().enumerate() {
-        let (ka, kb) = (a.index(), b.index());
-        let (k0, k1) = (ka.min(kb), ka.max(kb));
-        let idx: Vec<usize> = plan.range_2d(p).collect();
-        let x: Vec<f64> = idx.iter().map(|&i| samples[i].z[k0] / sigma[k0]).collect();
-        let y: Vec<f64> = idx.iter().map(|&i| samples[i].z[k1] / sigma[k1]).collect();
-        let psi: Vec<f64> = idx.iter().map(|&i| psi_of(i)).collect();
-        let stretch = |k: usize| k == 0 || k == 2;
-        let bending = k1 >= 3;
-        let o = Fit2DOptions {
-            n_knots: [if bending {
-                opts.n_knots_2d_bending
-            } else {
-                opts.n_knots_2d
-            }; 2],
-            extent: if bending {
-                opts.extent_2d_bending
-            } else {
-                opts.extent_2d
-            },
-            bandwidth_factor: opts.bandwidth_factor,
-            eps_rel: opts.eps_rel,
-            min_slope: opts.min_slope,
-            symmetric: [k0 == 1, k1 == 1],
-            quasi_convex: !(k0 == 0 && k1 == 2),
-            minimum_v: if k1 < 3 {
-                MinimumAt::Zero
-            } else {
-                MinimumAt::Argmin
-            },
-            stretch: [stretch(k0), stretch(k1)],
-            fd_step: 1e-3,
-            strict_patches: opts.strict_patches,
-        };
-        let fit = fit2d(&x, &y, &psi, &o).map_err(|e| {
-            FitError::BadOption(format!(
-                "2D term ({}, {}): {e}",
-                StrainComponent::NAMES[k0],
-                StrainComponent::NAMES[k1]
-            ))
-        })?;
-        fits2d.push((k0, k1, fit, TermData { x, y, psi }));
-    }
-
-    let mut material = Material {
-        density,
-        strain_scale: sigma,
-        constant,
-        terms1d: fits1d
-            .iter()
-            .map(|(k, f, _)| Term1D {
-                strain: StrainComponent::ALL[*k],
-                spline: f.spline.clone(),
-            })
-            .collect(),
-        terms2d: fits2d
-            .iter()
-            .map(|(k0, k1, f, _)| Term2D {
-                strains: [StrainComponent::ALL[*k0], StrainComponent::ALL[*k1]],
-                spline: f.residual.clone(),
-            })
-            .collect(),
-        extra: serde_json::Map::new(),
-    };
-
-    // reports
-    let recs = |range: std::ops::Range<usize>| -> Vec<&Record> {
-        range.filter_map(|i| by_index[i]).collect::<Vec<_>>()
-    };
-    let terms1d: Vec<Term1DReport> = fits1d
-        .iter()
-        .map(|(k, f, _)| Term1DReport {
-            k: *k,
-            strain: StrainComponent::ALL[*k],
-            n_samples: f.report.n_samples,
-            n_excluded: f.report.n_excluded,
-            fit_rms_rel: f.report.rms_rel,
-            fit_max_rel: f.report.max_rel,
-            offset: f.offset,
-            i_min: f.report.i_min,
-            model: model_error(&material, recs(plan.range_1d(*k))),
-        })
-        .collect();
-    let terms2d: Vec<Term2DReport> = fits2d
-        .iter()
-        .enumerate()
-        .map(|(p, (k0, k1, f, _))| Term2DReport {
-            k0: *k0,
-            k1: *k1,
-            strains: [StrainComponent::ALL[*k0], StrainComponent::ALL[*k1]],
-            n_samples: f.report.n_samples,
-            n_excluded: f.report.n_excluded,
-            fit_rms_rel: f.report.rms_rel,
-            fit_max_rel: f.report.max_rel,
-            twist_rounds: f.report.twist_rounds,
-            slope_rounds: f.report.slope_rounds,
-            nonmonotone_patches: f.report.nonmonotone_patches,
-            model: model_error(&material, recs(plan.range_2d(p))),
-        })
-        .collect();
-    let all = model_error(&material, recs(0..plan.grid_start()));
+    let (terms1d, terms2d) = term_reports(&material, plan, &by_index, &fits1d, &fits2d);
+    let all = model_error(&material, by_index.in_range(0..plan.grid_start()));
     // the plan's own in-plane grid is held out: never fitted, only predicted
     let holdout = plan
         .grid
         .as_ref()
-        .map(|_| model_error(&material, recs(plan.grid_start()..n)));
+        .map(|_| model_error(&material, by_index.in_range(plan.grid_start()..n)));
     let report = FitReport {
-        plan_hash: hash.clone(),
+        plan_hash: hash,
         samples: present.len(),
         converged,
         strain_scale: sigma,
@@ -446,34 +579,7 @@ pub fn fit_material(
         compare_1d: None,
     };
 
-    let mut meta = meta;
-    meta.insert("plan".into(), serde_json::json!(hash));
-    meta.insert(
-        "fit options".into(),
-        serde_json::json!({
-            "n_knots_1d": opts.n_knots_1d, "n_knots_2d": opts.n_knots_2d, "extent_2d": opts.extent_2d,
-            "n_knots_2d_bending": opts.n_knots_2d_bending, "extent_2d_bending": opts.extent_2d_bending,
-            "min_slope": opts.min_slope, "bandwidth_factor": opts.bandwidth_factor, "eps_rel": opts.eps_rel,
-            "slopes": format!("{:?}", opts.slopes), "thin_1d": opts.thin_1d,
-            "strict_patches": opts.strict_patches,
-        }),
-    );
-    meta.insert(
-        "fit errors".into(),
-        serde_json::json!({
-            "samples": report.samples, "converged": report.converged,
-            "model_rms_rel": report.all.rms_rel, "model_max_rel": report.all.max_rel,
-            "constant_spread": spread,
-            "holdout": report.holdout.as_ref().map(|h| serde_json::json!({
-                "samples": h.n_samples, "rms_rel": h.rms_rel, "max_rel": h.max_rel })),
-            "1D": report.terms1d.iter().map(|t| serde_json::json!({
-                "strain": t.strain, "rms_rel": t.model.rms_rel, "max_rel": t.model.max_rel,
-                "excluded": t.n_excluded })).collect::<Vec<_>>(),
-            "2D": report.terms2d.iter().map(|t| serde_json::json!({
-                "strains": t.strains, "rms_rel": t.model.rms_rel, "max_rel": t.model.max_rel,
-                "excluded": t.n_excluded, "nonmonotone_patches": t.nonmonotone_patches })).collect::<Vec<_>>(),
-        }),
-    );
+    let meta = meta_block(meta, opts, &report);
     material.extra.insert(
         "strain shift".into(),
         serde_json::json!([1.0, 0.0, 1.0, 0.0, 0.0]),

@@ -6,11 +6,41 @@ use super::fit1d::Fit1D;
 use super::fit2d::Fit2D;
 use super::model::{MaterialFit, TermData};
 use crate::strain::StrainComponent;
+use plotters::backend::DrawingBackend;
+use plotters::drawing::DrawingAreaErrorKind;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
-fn err<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> String + '_ {
-    move |e| format!("{}: cannot draw the plot: {e}", path.display())
+/// The error type of plotters' bitmap backend.
+type DrawError = DrawingAreaErrorKind<<BitMapBackend<'static> as DrawingBackend>::ErrorType>;
+
+/// What went wrong with one plot file or folder.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotErrorKind {
+    /// the plot folder could not be created
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// plotters could not draw the plot or write the PNG
+    #[error("cannot draw the plot: {0}")]
+    Draw(#[from] DrawError),
+}
+
+/// A plot that was not written: the file (or, for the folder, the folder) and why. Displayed as one line
+/// `PATH: what is wrong`.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: {kind}", path.display())]
+pub struct PlotError {
+    pub path: PathBuf,
+    pub kind: PlotErrorKind,
+}
+
+impl PlotError {
+    fn at(path: &Path) -> impl Fn(PlotErrorKind) -> PlotError + '_ {
+        move |kind| PlotError {
+            path: path.to_path_buf(),
+            kind,
+        }
+    }
 }
 
 /// Plot one 1D term: samples (Ψ̄ against the strain), g + (f₀ − offset) and f₀ + f_k, over 10 % beyond the data.
@@ -21,8 +51,18 @@ pub fn plot_term1d(
     data: &TermData,
     sigma: f64,
     constant: f64,
-) -> Result<(), String> {
-    let e = err(path);
+) -> Result<(), PlotError> {
+    draw_term1d(path, k, fit, data, sigma, constant).map_err(PlotError::at(path))
+}
+
+fn draw_term1d(
+    path: &Path,
+    k: usize,
+    fit: &Fit1D,
+    data: &TermData,
+    sigma: f64,
+    constant: f64,
+) -> Result<(), PlotErrorKind> {
     let pts: Vec<(f64, f64)> = data
         .x
         .iter()
@@ -57,7 +97,7 @@ pub fn plot_term1d(
     let failed = data.psi.iter().filter(|p| !p.is_finite()).count();
 
     let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
-    root.fill(&WHITE).map_err(&e)?;
+    root.fill(&WHITE)?;
     let title = format!(
         "f0 + f_{k} ({}): {} samples, {} failed, fit RMS {:.2e}",
         StrainComponent::NAMES[k],
@@ -70,35 +110,29 @@ pub fn plot_term1d(
         .margin(15)
         .x_label_area_size(45)
         .y_label_area_size(70)
-        .build_cartesian_2d(lo * sigma..hi * sigma, ymin - pad..ymax + pad)
-        .map_err(&e)?;
+        .build_cartesian_2d(lo * sigma..hi * sigma, ymin - pad..ymax + pad)?;
     chart
         .configure_mesh()
         .x_desc(StrainComponent::NAMES[k])
         .y_desc("energy density [J/m2]")
-        .draw()
-        .map_err(&e)?;
+        .draw()?;
     chart
-        .draw_series(pts.iter().map(|&p| Circle::new(p, 3, BLUE.filled())))
-        .map_err(&e)?
+        .draw_series(pts.iter().map(|&p| Circle::new(p, 3, BLUE.filled())))?
         .label("micro samples")
         .legend(|(x, y)| Circle::new((x, y), 3, BLUE.filled()));
     chart
-        .draw_series(LineSeries::new(curve, GREEN.stroke_width(2)))
-        .map_err(&e)?
+        .draw_series(LineSeries::new(curve, GREEN.stroke_width(2)))?
         .label("MLS curve g")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], GREEN.stroke_width(2)));
     chart
-        .draw_series(LineSeries::new(spline, RED.stroke_width(2)))
-        .map_err(&e)?
+        .draw_series(LineSeries::new(spline, RED.stroke_width(2)))?
         .label("spline f0 + f_k")
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
     chart
         .draw_series(fit.spline.t.iter().map(|&t| {
             let y = constant + fit.spline.eval2(t)[0];
             Cross::new((t * sigma, y), 5, BLACK.stroke_width(2))
-        }))
-        .map_err(&e)?
+        }))?
         .label("knots")
         .legend(|(x, y)| Cross::new((x, y), 5, BLACK.stroke_width(2)));
     chart
@@ -106,9 +140,8 @@ pub fn plot_term1d(
         .position(SeriesLabelPosition::UpperMiddle)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
-        .draw()
-        .map_err(&e)?;
-    root.present().map_err(&e)?;
+        .draw()?;
+    root.present()?;
     Ok(())
 }
 
@@ -148,8 +181,18 @@ pub fn plot_term2d(
     fit: &Fit2D,
     data: &TermData,
     sigma: [f64; 2],
-) -> Result<(), String> {
-    let e = err(path);
+) -> Result<(), PlotError> {
+    draw_term2d(path, k0, k1, fit, data, sigma).map_err(PlotError::at(path))
+}
+
+fn draw_term2d(
+    path: &Path,
+    k0: usize,
+    k1: usize,
+    fit: &Fit2D,
+    data: &TermData,
+    sigma: [f64; 2],
+) -> Result<(), PlotErrorKind> {
     let range = |d: &[f64]| {
         d.iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
@@ -175,7 +218,7 @@ pub fn plot_term2d(
     let (fmin, fmax) = range(&full);
     let rmax = res.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300);
     let root = BitMapBackend::new(path, (1400, 650)).into_drawing_area();
-    root.fill(&WHITE).map_err(&e)?;
+    root.fill(&WHITE)?;
     let (left, right) = root.split_horizontally(700);
     let failed: Vec<(f64, f64)> = (0..data.psi.len())
         .filter(|&i| !data.psi[i].is_finite())
@@ -207,46 +250,42 @@ pub fn plot_term2d(
             .margin(15)
             .x_label_area_size(45)
             .y_label_area_size(60)
-            .build_cartesian_2d(u0 * sigma[0]..u1 * sigma[0], v0 * sigma[1]..v1 * sigma[1])
-            .map_err(&e)?;
+            .build_cartesian_2d(u0 * sigma[0]..u1 * sigma[0], v0 * sigma[1]..v1 * sigma[1])?;
         chart
             .configure_mesh()
             .disable_mesh()
             .x_desc(StrainComponent::NAMES[k0])
             .y_desc(StrainComponent::NAMES[k1])
-            .draw()
-            .map_err(&e)?;
-        chart
-            .draw_series((0..n * n).map(|c| {
-                let (i, j) = (c % n, c / n);
-                let x = [cell(i, u0, u1) * sigma[0], cell(i + 1, u0, u1) * sigma[0]];
-                let y = [cell(j, v0, v1) * sigma[1], cell(j + 1, v0, v1) * sigma[1]];
-                let v = values[c];
-                let colour = if residual {
-                    diverging(v / rmax)
-                } else {
-                    // logarithmic colour scale over the value range (energies span decades)
-                    let e = 1e-3 * (fmax - fmin).max(1e-300);
-                    ramp(((v - fmin) / e).ln_1p() / ((fmax - fmin) / e).ln_1p())
-                };
-                Rectangle::new([(x[0], y[0]), (x[1], y[1])], colour.filled())
-            }))
-            .map_err(&e)?;
-        chart
-            .draw_series(
-                failed
-                    .iter()
-                    .map(|&p| Cross::new(p, 4, BLACK.stroke_width(2))),
-            )
-            .map_err(&e)?;
+            .draw()?;
+        chart.draw_series((0..n * n).map(|c| {
+            let (i, j) = (c % n, c / n);
+            let x = [cell(i, u0, u1) * sigma[0], cell(i + 1, u0, u1) * sigma[0]];
+            let y = [cell(j, v0, v1) * sigma[1], cell(j + 1, v0, v1) * sigma[1]];
+            let v = values[c];
+            let colour = if residual {
+                diverging(v / rmax)
+            } else {
+                // logarithmic colour scale over the value range (energies span decades)
+                let e = 1e-3 * (fmax - fmin).max(1e-300);
+                ramp(((v - fmin) / e).ln_1p() / ((fmax - fmin) / e).ln_1p())
+            };
+            Rectangle::new([(x[0], y[0]), (x[1], y[1])], colour.filled())
+        }))?;
+        chart.draw_series(
+            failed
+                .iter()
+                .map(|&p| Cross::new(p, 4, BLACK.stroke_width(2))),
+        )?;
     }
-    root.present().map_err(&e)?;
+    root.present()?;
     Ok(())
 }
 
 /// Write every term's plot to `dir` (`1d_<strain>.png`, `2d_<strain>_<strain>.png`); returns the paths.
-pub fn plot_material_fit(dir: &Path, fit: &MaterialFit) -> Result<Vec<PathBuf>, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+pub fn plot_material_fit(dir: &Path, fit: &MaterialFit) -> Result<Vec<PathBuf>, PlotError> {
+    std::fs::create_dir_all(dir)
+        .map_err(PlotErrorKind::from)
+        .map_err(PlotError::at(dir))?;
     let sigma = fit.material.strain_scale;
     let mut out = Vec::new();
     for (k, f, d) in &fit.fits1d {

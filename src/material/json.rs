@@ -11,25 +11,17 @@
 
 use super::{Hermite1D, Hermite2D, Material, StrainComponent, Term1D, Term2D};
 use serde_json::{Map, Value};
-use std::fmt;
 use std::path::Path;
 
 /// A material file problem: the file, the field (a JSON path such as `coeffs.1D[2].t[4]`, or a line and column
 /// for syntax errors) and what is wrong.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}: {field}: {message}")]
 pub struct MaterialError {
     pub file: String,
     pub field: String,
     pub message: String,
 }
-
-impl fmt::Display for MaterialError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}: {}", self.file, self.field, self.message)
-    }
-}
-
-impl std::error::Error for MaterialError {}
 
 type Res<T> = Result<T, (String, String)>;
 

@@ -79,100 +79,111 @@ pub struct SpectralVgh {
     pub hess: [[f64; 4]; 4],
 }
 
-/// [φ(u, L)]₀₀ = c₀ + c₁ δ with its first and second derivatives in w = (u, m, δ, b).
-/// For the 11 component pass −δ and flip the sign of the δ row/column of the result.
-pub fn spectral_00<F: LambdaFamily>(f: &F, m: f64, delta: f64, b: f64) -> SpectralVgh {
-    let q = delta * delta + b * b;
-    let d = q.sqrt();
-    let (l1, l2) = (m + d, m - d);
-    let (p1, p2) = (f.piece(l1), f.piece(l2));
-    // G(y), y = (u, m, s, δ), with s = q (same piece) or s = d (different pieces); gy and hy its derivatives.
-    let (g, gy, hy, s_is_q) = if p1 == p2 || d <= D_MIN {
-        let piece = if p1 == p2 { p1 } else { f.piece(m) };
-        let [f0, f1, f2] = f.derivs_on(piece, m);
-        let s = q;
-        let g = f0[0] + 0.5 * f0[2] * s + f0[1] * delta + f0[3] * s * delta / 6.0;
-        let gy = [
-            f1[0] + 0.5 * f1[2] * s + f1[1] * delta + f1[3] * s * delta / 6.0,
-            f0[1] + 0.5 * f0[3] * s + f0[2] * delta,
-            0.5 * f0[2] + f0[3] * delta / 6.0,
-            f0[1] + f0[3] * s / 6.0,
-        ];
-        let huu = f2[0] + 0.5 * f2[2] * s + f2[1] * delta + f2[3] * s * delta / 6.0;
-        let hum = f1[1] + 0.5 * f1[3] * s + f1[2] * delta;
-        let hus = 0.5 * f1[2] + f1[3] * delta / 6.0;
-        let hud = f1[1] + f1[3] * s / 6.0;
-        let hmm = f0[2] + f0[3] * delta;
-        let hms = 0.5 * f0[3];
-        let hmd = f0[2];
-        let hsd = f0[3] / 6.0;
-        let hy = [
-            [huu, hum, hus, hud],
-            [hum, hmm, hms, hmd],
-            [hus, hms, 0.0, hsd],
-            [hud, hmd, hsd, 0.0],
-        ];
-        (g, gy, hy, true)
-    } else {
-        // (φ, φ_u, φ_λ, φ_uu, φ_uλ, φ_λλ) at λ₁ and λ₂: only total order ≤ 2 enters
-        let a = f.low_on(p1, l1);
-        let bb = f.low_on(p2, l2);
-        // positions in `low_on`'s output of ∂ᵃ_u ∂ᵇ_λ, keyed (a, b)
-        let at = |i: usize, j: usize| match (i, j) {
-            (0, 0) => 0,
-            (1, 0) => 1,
-            (0, 1) => 2,
-            (2, 0) => 3,
-            (1, 1) => 4,
-            _ => 5,
-        };
-        let half_sum = |i: usize, j: usize| 0.5 * (a[at(i, j)] + bb[at(i, j)]);
-        let half_dif = |i: usize, j: usize| 0.5 * (a[at(i, j)] - bb[at(i, j)]);
-        // c₀(u, m, d) and its derivatives (λ₁ = m + d, λ₂ = m − d)
-        let c0 = half_sum(0, 0);
-        let (c0u, c0m, c0d) = (half_sum(1, 0), half_sum(0, 1), half_dif(0, 1));
-        let (c0uu, c0um, c0ud) = (half_sum(2, 0), half_sum(1, 1), half_dif(1, 1));
-        let (c0mm, c0md, c0dd) = (half_sum(0, 2), half_dif(0, 2), half_sum(0, 2));
-        // N = (φ(λ₁) − φ(λ₂))/2 and c₁ = N/d
-        let n = half_dif(0, 0);
-        let (nu, nm, nd) = (half_dif(1, 0), half_dif(0, 1), half_sum(0, 1));
-        let (nuu, num, nud) = (half_dif(2, 0), half_dif(1, 1), half_sum(1, 1));
-        let (nmm, nmd, ndd) = (half_dif(0, 2), half_sum(0, 2), half_dif(0, 2));
-        let id = 1.0 / d;
-        let c1 = n * id;
-        let (c1u, c1m) = (nu * id, nm * id);
-        let c1d = (nd - c1) * id;
-        let (c1uu, c1um, c1mm) = (nuu * id, num * id, nmm * id);
-        let c1ud = (nud - c1u) * id;
-        let c1md = (nmd - c1m) * id;
-        let c1dd = (ndd - 2.0 * c1d) * id;
-        let g = c0 + c1 * delta;
-        let gy = [c0u + c1u * delta, c0m + c1m * delta, c0d + c1d * delta, c1];
-        let hy = [
-            [
-                c0uu + c1uu * delta,
-                c0um + c1um * delta,
-                c0ud + c1ud * delta,
-                c1u,
-            ],
-            [
-                c0um + c1um * delta,
-                c0mm + c1mm * delta,
-                c0md + c1md * delta,
-                c1m,
-            ],
-            [
-                c0ud + c1ud * delta,
-                c0md + c1md * delta,
-                c0dd + c1dd * delta,
-                c1d,
-            ],
-            [c1u, c1m, c1d, 0.0],
-        ];
-        (g, gy, hy, false)
+/// G(y) with its gradient and Hessian in y = (u, m, s, δ).
+type GyHy = (f64, [f64; 4], [[f64; 4]; 4]);
+
+/// G = c₀ + c₁ δ on one polynomial piece, in y = (u, m, q, δ) (see the module documentation).
+#[inline]
+fn same_piece<F: LambdaFamily>(f: &F, piece: usize, m: f64, delta: f64, q: f64) -> GyHy {
+    let [f0, f1, f2] = f.derivs_on(piece, m);
+    let s = q;
+    let g = f0[0] + 0.5 * f0[2] * s + f0[1] * delta + f0[3] * s * delta / 6.0;
+    let gy = [
+        f1[0] + 0.5 * f1[2] * s + f1[1] * delta + f1[3] * s * delta / 6.0,
+        f0[1] + 0.5 * f0[3] * s + f0[2] * delta,
+        0.5 * f0[2] + f0[3] * delta / 6.0,
+        f0[1] + f0[3] * s / 6.0,
+    ];
+    let huu = f2[0] + 0.5 * f2[2] * s + f2[1] * delta + f2[3] * s * delta / 6.0;
+    let hum = f1[1] + 0.5 * f1[3] * s + f1[2] * delta;
+    let hus = 0.5 * f1[2] + f1[3] * delta / 6.0;
+    let hud = f1[1] + f1[3] * s / 6.0;
+    let hmm = f0[2] + f0[3] * delta;
+    let hms = 0.5 * f0[3];
+    let hmd = f0[2];
+    let hsd = f0[3] / 6.0;
+    let hy = [
+        [huu, hum, hus, hud],
+        [hum, hmm, hms, hmd],
+        [hus, hms, 0.0, hsd],
+        [hud, hmd, hsd, 0.0],
+    ];
+    (g, gy, hy)
+}
+
+/// G = c₀ + c₁ δ from φ at λ₁ = m + d on piece `p1` and λ₂ = m − d on piece `p2`, in y = (u, m, d, δ):
+/// c₀ = (φ(λ₁) + φ(λ₂))/2 and c₁ = N/d with N = (φ(λ₁) − φ(λ₂))/2.
+#[inline]
+fn different_pieces<F: LambdaFamily>(
+    f: &F,
+    (p1, l1): (usize, f64),
+    (p2, l2): (usize, f64),
+    delta: f64,
+    d: f64,
+) -> GyHy {
+    // (φ, φ_u, φ_λ, φ_uu, φ_uλ, φ_λλ) at λ₁ and λ₂: only total order ≤ 2 enters
+    let a = f.low_on(p1, l1);
+    let bb = f.low_on(p2, l2);
+    // positions in `low_on`'s output of ∂ᵃ_u ∂ᵇ_λ, keyed (a, b)
+    let at = |i: usize, j: usize| match (i, j) {
+        (0, 0) => 0,
+        (1, 0) => 1,
+        (0, 1) => 2,
+        (2, 0) => 3,
+        (1, 1) => 4,
+        _ => 5,
     };
-    // Chain y = (u, m, s(δ, b), δ) ← w = (u, m, δ, b).
-    let (sd, sb, sdd, sdb, sbb) = if s_is_q {
+    let half_sum = |i: usize, j: usize| 0.5 * (a[at(i, j)] + bb[at(i, j)]);
+    let half_dif = |i: usize, j: usize| 0.5 * (a[at(i, j)] - bb[at(i, j)]);
+    // c₀(u, m, d) and its derivatives (λ₁ = m + d, λ₂ = m − d)
+    let c0 = half_sum(0, 0);
+    let (c0u, c0m, c0d) = (half_sum(1, 0), half_sum(0, 1), half_dif(0, 1));
+    let (c0uu, c0um, c0ud) = (half_sum(2, 0), half_sum(1, 1), half_dif(1, 1));
+    let (c0mm, c0md, c0dd) = (half_sum(0, 2), half_dif(0, 2), half_sum(0, 2));
+    // N = (φ(λ₁) − φ(λ₂))/2 and c₁ = N/d
+    let n = half_dif(0, 0);
+    let (nu, nm, nd) = (half_dif(1, 0), half_dif(0, 1), half_sum(0, 1));
+    let (nuu, num, nud) = (half_dif(2, 0), half_dif(1, 1), half_sum(1, 1));
+    let (nmm, nmd, ndd) = (half_dif(0, 2), half_sum(0, 2), half_dif(0, 2));
+    let id = 1.0 / d;
+    let c1 = n * id;
+    let (c1u, c1m) = (nu * id, nm * id);
+    let c1d = (nd - c1) * id;
+    let (c1uu, c1um, c1mm) = (nuu * id, num * id, nmm * id);
+    let c1ud = (nud - c1u) * id;
+    let c1md = (nmd - c1m) * id;
+    let c1dd = (ndd - 2.0 * c1d) * id;
+    let g = c0 + c1 * delta;
+    let gy = [c0u + c1u * delta, c0m + c1m * delta, c0d + c1d * delta, c1];
+    let hy = [
+        [
+            c0uu + c1uu * delta,
+            c0um + c1um * delta,
+            c0ud + c1ud * delta,
+            c1u,
+        ],
+        [
+            c0um + c1um * delta,
+            c0mm + c1mm * delta,
+            c0md + c1md * delta,
+            c1m,
+        ],
+        [
+            c0ud + c1ud * delta,
+            c0md + c1md * delta,
+            c0dd + c1dd * delta,
+            c1d,
+        ],
+        [c1u, c1m, c1d, 0.0],
+    ];
+    (g, gy, hy)
+}
+
+/// The chain rule y = (u, m, s(δ, b), δ) ← w = (u, m, δ, b): (s_δ, s_b, s_δδ, s_δb, s_bb) for s = q = δ² + b²
+/// (`s_is_q`) or s = d = √q.
+#[inline]
+fn s_derivs(delta: f64, b: f64, d: f64, s_is_q: bool) -> (f64, f64, f64, f64, f64) {
+    if s_is_q {
         (2.0 * delta, 2.0 * b, 2.0, 0.0, 2.0)
     } else {
         let id = 1.0 / d;
@@ -184,7 +195,26 @@ pub fn spectral_00<F: LambdaFamily>(f: &F, m: f64, delta: f64, b: f64) -> Spectr
             -delta * b * id3,
             delta * delta * id3,
         )
+    }
+}
+
+/// [φ(u, L)]₀₀ = c₀ + c₁ δ with its first and second derivatives in w = (u, m, δ, b).
+/// For the 11 component pass −δ and flip the sign of the δ row/column of the result.
+pub fn spectral_00<F: LambdaFamily>(f: &F, m: f64, delta: f64, b: f64) -> SpectralVgh {
+    let q = delta * delta + b * b;
+    let d = q.sqrt();
+    let (l1, l2) = (m + d, m - d);
+    let (p1, p2) = (f.piece(l1), f.piece(l2));
+    // G(y), y = (u, m, s, δ), with s = q (same piece) or s = d (different pieces); gy and hy its derivatives.
+    let s_is_q = p1 == p2 || d <= D_MIN;
+    let (g, gy, hy) = if s_is_q {
+        let piece = if p1 == p2 { p1 } else { f.piece(m) };
+        same_piece(f, piece, m, delta, q)
+    } else {
+        different_pieces(f, (p1, l1), (p2, l2), delta, d)
     };
+    // Chain y = (u, m, s(δ, b), δ) ← w = (u, m, δ, b).
+    let (sd, sb, sdd, sdb, sbb) = s_derivs(delta, b, d, s_is_q);
     // H_w = Jᵀ H_y J + G_s ∇²s with J = ∂y/∂w: columns e_u, e_m, s_δ e_s + e_δ, s_b e_s
     let h = &hy;
     let gs = gy[2];
