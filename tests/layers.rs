@@ -6,8 +6,24 @@ use std::path::{Path, PathBuf};
 
 /// The crate's top-level modules from the bottom layer up (the order of `src/lib.rs`).
 const ORDER: &[&str] = &[
-    "sparse", "strain", "real", "periodic", "diff", "material", "pattern", "rod", "contact",
-    "tile", "micro", "sample", "fit", "shell", "generate", "workflow", "validation", "checks",
+    "sparse",
+    "strain",
+    "real",
+    "periodic",
+    "diff",
+    "material",
+    "pattern",
+    "rod",
+    "contact",
+    "tile",
+    "micro",
+    "sample",
+    "fit",
+    "shell",
+    "generate",
+    "workflow",
+    "validation",
+    "checks",
 ];
 
 fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
