@@ -3,13 +3,15 @@
 //!
 //! - [`conformance`]: ψ and the strain chain against the original code's oracle vectors (item 3a);
 //! - [`calibration`]: the yarn parameters that make the original reference patterns static equilibria (item 3b);
-//! - [`grid`]: our micro solver against the original solver's displacements on the 9×9×9 grid (item 3c).
+//! - [`grid`]: our micro solver against the original solver's displacements on the 9×9×9 grid (item 3c);
+//! - [`fuzz`]: mutated inputs of the five input formats through the parsers and evaluators (issue 17).
 //!
 //! Each reads `../shared` (the caller passes the folder or files) and returns numbers; the callers (`hylc
 //! validate`, `hylc calibrate`, `hylc micro-grid`, the conformance tests) decide what passes.
 
 pub mod calibration;
 pub mod conformance;
+pub mod fuzz;
 pub mod grid;
 
 use std::path::PathBuf;

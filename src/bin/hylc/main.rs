@@ -6,6 +6,7 @@ mod args;
 mod calibrate;
 mod check_derivatives;
 mod fit;
+mod fuzz;
 mod generate;
 mod material;
 mod merge;
@@ -51,6 +52,7 @@ enum Command {
     Sensitivity(sensitivity::Args),
     MicroGrid(micro_grid::Args),
     Calibrate(calibrate::Args),
+    Fuzz(fuzz::Args),
     Simulate(simulate::Args),
 }
 
@@ -101,6 +103,7 @@ fn main() -> ExitCode {
         Command::Sensitivity(a) => sensitivity::run(a),
         Command::MicroGrid(a) => micro_grid::run(a),
         Command::Calibrate(a) => calibrate::run(a),
+        Command::Fuzz(a) => fuzz::run_cmd(a),
         Command::Simulate(a) => simulate::run(a),
     };
     match result {
