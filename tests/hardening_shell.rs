@@ -146,6 +146,32 @@ fn physical_parameters_out_of_range_are_errors_naming_the_field() {
             "field `contact.thickness`",
             Box::new(|s| s.contact.thickness = f64::INFINITY),
         ),
+        ("field `dt`", Box::new(|s| s.dt = 1e-12)),
+        (
+            "field `placement.origin`",
+            Box::new(|s| s.placement.origin = [1e300, 0.0, 0.0]),
+        ),
+        (
+            "field `placement`",
+            Box::new(|s| s.placement.u = [1e200, 0.0, 0.0]),
+        ),
+        (
+            "field `handles[0].keyframes`",
+            Box::new(|s| {
+                s.handles = scene::builtin("stretch-x").unwrap().handles;
+                s.pins.clear();
+                s.handles[0].keyframes[1].1 = [1e300, 0.0, 0.0];
+            }),
+        ),
+        (
+            "field `obstacles[0]`",
+            Box::new(|s| {
+                s.obstacles = vec![hylc::shell::solver::Obstacle::Sphere {
+                    center: [0.0, 0.0, -1e300],
+                    radius: 1.0,
+                }]
+            }),
+        ),
         (
             "field `fabric_angle_deg`",
             Box::new(|s| s.fabric_angle_deg = f64::NAN),

@@ -287,6 +287,18 @@ pub struct HandleSpec {
 /// smallest meshes (the built-ins take 60, `hylc run`'s drape 240); checked before the simulation is built.
 pub const MAX_STEPS: usize = 1_000_000;
 
+/// The smallest time step (s) a dynamic scene accepts: the inertia term m/dt² of the Newton matrix grows as
+/// 1/dt², and below a nanosecond it swamps the elastic terms by more than the precision of a double.
+pub const MIN_DT: f64 = 1e-9;
+
+/// The largest coordinate or length (m) a scene accepts in its placement origin, handle offsets and obstacles: a
+/// thousand kilometres, far beyond any cloth, and far from overflow when squared.
+pub const MAX_COORDINATE: f64 = 1e6;
+
+/// The largest component of the placement axes `u` and `v` (they scale the rest layout into the initial state;
+/// unit vectors place it unstretched).
+pub const MAX_AXIS: f64 = 1e3;
+
 /// The largest gravity magnitude (m/s²) a scene accepts: a thousand times the Earth's, far beyond any cloth
 /// experiment, and small enough that the forces m g stay many orders of magnitude from overflow.
 pub const MAX_GRAVITY: f64 = 1e4;
@@ -431,6 +443,12 @@ impl Scene {
         if !(self.dt > 0.0 && self.dt.is_finite()) {
             return bad("dt", format!("must be positive, got {}", self.dt));
         }
+        if self.dt < MIN_DT {
+            return bad(
+                "dt",
+                format!("{} s is below the limit of {MIN_DT:e} s", self.dt),
+            );
+        }
         if self.duration > 0.0 && self.dt > self.duration {
             return bad(
                 "dt",
@@ -522,25 +540,53 @@ impl Scene {
         Ok(())
     }
 
-    /// The fabric angle and the obstacles.
+    /// The fabric angle, the placement, the handle offsets and the obstacles (bounded by [`MAX_COORDINATE`] and
+    /// [`MAX_AXIS`]).
     fn validate_geometry(&self, file: &str) -> Result<(), ShellError> {
         let bad = |field: &str, msg: String| Err(ShellError::scene(file, field, msg));
+        let within = |v: &[f64], limit: f64| v.iter().all(|x| x.abs() <= limit);
+        let pl = &self.placement;
+        if !within(&pl.origin, MAX_COORDINATE) {
+            return bad(
+                "placement.origin",
+                format!("coordinates must be within ±{MAX_COORDINATE:e} m"),
+            );
+        }
+        if !(within(&pl.u, MAX_AXIS) && within(&pl.v, MAX_AXIS)) {
+            return bad(
+                "placement",
+                format!("the components of u and v must be within ±{MAX_AXIS:e}"),
+            );
+        }
+        for (i, h) in self.handles.iter().enumerate() {
+            if h.keyframes.iter().any(|k| !within(&k.1, MAX_COORDINATE)) {
+                return bad(
+                    &format!("handles[{i}].keyframes"),
+                    format!("offsets must be within ±{MAX_COORDINATE:e} m"),
+                );
+            }
+        }
         if !self.fabric_angle_deg.is_finite() {
             return bad("fabric_angle_deg", "must be finite".into());
         }
         for (i, o) in self.obstacles.iter().enumerate() {
             let ok = match o {
-                Obstacle::Sphere { radius, .. } => *radius > 0.0 && radius.is_finite(),
-                Obstacle::Plane { normal, .. } => {
+                Obstacle::Sphere { center, radius } => {
+                    *radius > 0.0 && *radius <= MAX_COORDINATE && within(center, MAX_COORDINATE)
+                }
+                Obstacle::Plane { point, normal } if within(point, MAX_COORDINATE) => {
                     let l = (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2])
                         .sqrt();
                     l > 0.0 && l.is_finite()
                 }
+                Obstacle::Plane { .. } => false,
             };
             if !ok {
                 return bad(
                     &format!("obstacles[{i}]"),
-                    "needs a positive radius / non-zero normal".into(),
+                    format!(
+                        "needs a positive radius / non-zero normal, coordinates within ±{MAX_COORDINATE:e} m"
+                    ),
                 );
             }
         }
