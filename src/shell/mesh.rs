@@ -14,6 +14,15 @@ use rand_chacha::ChaCha8Rng;
 use std::collections::HashMap;
 use std::path::Path;
 
+/// The most vertices a mesh may have (rectangle or OBJ): 5 million vertices are about 1.3 GB of simulation state
+/// and sparse Hessian (about 260 bytes per vertex) and hours per simulated second on a workstation, far beyond
+/// any cloth the homogenized model is meant for (the built-ins have 2 704); checked before any allocation.
+pub const MAX_VERTICES: usize = 5_000_000;
+
+/// The most triangles a mesh may have: twice [`MAX_VERTICES`] (a regular grid has about two triangles per
+/// vertex); checked before any allocation.
+pub const MAX_TRIANGLES: usize = 2 * MAX_VERTICES;
+
 /// A flat triangle mesh: rest layout (m) and triangles (vertex indices).
 #[derive(Clone, Debug)]
 pub struct Mesh {
@@ -43,25 +52,7 @@ impl Mesh {
         perturb: f64,
         seed: u64,
     ) -> Result<Mesh, ShellError> {
-        if !(width > 0.0 && height > 0.0 && edge > 0.0 && width.is_finite() && height.is_finite()) {
-            return Err(ShellError::Rectangle {
-                message: format!(
-                    "width, height and edge must be positive (got {width}, {height}, {edge})"
-                ),
-            });
-        }
-        if !(0.0..0.5).contains(&perturb) {
-            return Err(ShellError::Rectangle {
-                message: format!("perturb must be in [0, 0.5), got {perturb}"),
-            });
-        }
-        let nx = ((width / edge).round() as usize).max(1);
-        let ny = ((height / edge).round() as usize).max(1);
-        if (nx + 1) * (ny + 1) > 5_000_000 {
-            return Err(ShellError::Rectangle {
-                message: format!("{nx}x{ny} cells is too many"),
-            });
-        }
+        let (nx, ny) = Self::rectangle_cells(width, height, edge, perturb)?;
         let (hx, hy) = (width / nx as f64, height / ny as f64);
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let mut rest = Vec::with_capacity((nx + 1) * (ny + 1));
@@ -97,6 +88,42 @@ impl Mesh {
             .map(|t| format!("rectangle triangle {t}"))
             .collect();
         Ok(Mesh { rest, tris, origin })
+    }
+
+    /// The cells (nx, ny) of a rectangle: checks the sizes (finite and positive), `perturb` and the vertex count
+    /// against [`MAX_VERTICES`] in floating point, before anything is allocated or cast.
+    fn rectangle_cells(
+        width: f64,
+        height: f64,
+        edge: f64,
+        perturb: f64,
+    ) -> Result<(usize, usize), ShellError> {
+        let finite_positive = |v: f64| v > 0.0 && v.is_finite();
+        if !(finite_positive(width) && finite_positive(height) && finite_positive(edge)) {
+            return Err(ShellError::Rectangle {
+                message: format!(
+                    "width, height and edge must be positive finite numbers (got {width}, {height}, {edge})"
+                ),
+            });
+        }
+        if !(0.0..0.5).contains(&perturb) {
+            return Err(ShellError::Rectangle {
+                message: format!("perturb must be in [0, 0.5), got {perturb}"),
+            });
+        }
+        let fx = (width / edge).round().max(1.0);
+        let fy = (height / edge).round().max(1.0);
+        let vertices = (fx + 1.0) * (fy + 1.0);
+        // finite positive sizes: the count is a number or +inf, never NaN
+        if vertices > MAX_VERTICES as f64 {
+            return Err(ShellError::Rectangle {
+                message: format!(
+                    "{fx:e} x {fy:e} cells ({vertices:e} vertices) is too many (at most {MAX_VERTICES} vertices: \
+                     a larger edge?)"
+                ),
+            });
+        }
+        Ok((fx as usize, fy as usize))
     }
 
     /// Read an OBJ file (`v` and `f` lines; other statements are ignored; polygons are fan-triangulated). The
@@ -136,6 +163,11 @@ impl Mesh {
                             .filter(|x| x.is_finite())
                             .ok_or_else(|| err(format!("bad vertex coordinate {:?}", c[k])))?;
                     }
+                    if pos.len() == MAX_VERTICES {
+                        return Err(err(format!(
+                            "more than {MAX_VERTICES} vertices (the limit of a mesh)"
+                        )));
+                    }
                     pos.push(p);
                     vline.push(ln);
                 }
@@ -159,6 +191,11 @@ impl Mesh {
                         return Err(err(format!(
                             "face needs at least 3 vertices, got {}",
                             idx.len()
+                        )));
+                    }
+                    if tris.len() + idx.len() - 2 > MAX_TRIANGLES {
+                        return Err(err(format!(
+                            "more than {MAX_TRIANGLES} triangles (the limit of a mesh)"
                         )));
                     }
                     for k in 1..idx.len() - 1 {

@@ -65,6 +65,14 @@ pub enum ShellError {
         /// "selects no vertex", "overlaps a pin"
         problem: &'static str,
     },
+    /// A vertex selection of a scene listing a vertex index the mesh does not have.
+    #[error("{file}: field `{field}`: vertex index {index} out of range (the mesh has {vertices} vertices, 0-based)")]
+    SelectionIndex {
+        file: String,
+        field: String,
+        index: usize,
+        vertices: usize,
+    },
     /// The material file a scene names could not be loaded.
     #[error("{file}: field `material`: {source}")]
     Material {
@@ -122,6 +130,30 @@ pub enum ShellError {
     /// A triangle became degenerate during a step's Newton iterations.
     #[error("step {step}: a triangle became degenerate")]
     Degenerate { step: usize },
+    /// The material's energy is not finite (NaN or infinite) at a triangle's strain, in the initial state
+    /// (`step` None) or during step `step`.
+    #[error(
+        "{}the material's energy is not finite at triangle {triangle} (strain z = {z:?}): the material evaluates \
+         to NaN or infinity there",
+        step.map(|s| format!("step {s}: ")).unwrap_or_default()
+    )]
+    NonFiniteMaterial {
+        triangle: usize,
+        z: [f64; 6],
+        step: Option<usize>,
+    },
+    /// A quantity of a step is not finite: the simulation diverged and stops (no NaN or infinity is reported as a
+    /// result); `hylc simulate` exits with code 3.
+    #[error(
+        "step {step} (t = {time:.4} s): the {quantity} is {value}: the simulation diverged (a smaller dt, smaller \
+         loads?)"
+    )]
+    NonFiniteState {
+        step: usize,
+        time: f64,
+        quantity: &'static str,
+        value: f64,
+    },
     /// The Newton matrix of a step could not be factorised at any diagonal shift.
     #[error("step {step}: the Newton system could not be factorised even with a diagonal shift")]
     Factorization { step: usize },

@@ -220,6 +220,42 @@ pub enum Selection {
 }
 
 impl Selection {
+    /// The first listed vertex index the mesh of `vertices` vertices does not have (only `{"vertices": [..]}`
+    /// lists indices).
+    fn out_of_range(&self, vertices: usize) -> Option<usize> {
+        match self {
+            Selection::Vertices(list) => list.iter().copied().find(|&v| v >= vertices),
+            _ => None,
+        }
+    }
+
+    /// The selection's vertices, or an error naming `field` when it lists a vertex the mesh does not have or
+    /// selects none.
+    fn select_checked(
+        &self,
+        mesh: &Mesh,
+        file: &str,
+        field: String,
+    ) -> Result<Vec<usize>, ShellError> {
+        if let Some(index) = self.out_of_range(mesh.len()) {
+            return Err(ShellError::SelectionIndex {
+                file: file.to_string(),
+                field,
+                index,
+                vertices: mesh.len(),
+            });
+        }
+        let v = self.select(mesh);
+        if v.is_empty() {
+            return Err(ShellError::Selection {
+                file: file.to_string(),
+                field,
+                problem: "selects no vertex",
+            });
+        }
+        Ok(v)
+    }
+
     fn select(&self, mesh: &Mesh) -> Vec<usize> {
         let eps = 1e-9;
         (0..mesh.len())
@@ -246,6 +282,30 @@ pub struct HandleSpec {
     pub select: Selection,
     pub keyframes: Vec<(f64, [f64; 3])>,
 }
+
+/// The most time steps a scene may take (⌈duration / dt⌉): a million steps are hours of wall time even on the
+/// smallest meshes (the built-ins take 60, `hylc run`'s drape 240); checked before the simulation is built.
+pub const MAX_STEPS: usize = 1_000_000;
+
+/// The smallest time step (s) a dynamic scene accepts: the inertia term m/dt² of the Newton matrix grows as
+/// 1/dt², and below a nanosecond it swamps the elastic terms by more than the precision of a double.
+pub const MIN_DT: f64 = 1e-9;
+
+/// The largest coordinate or length (m) a scene accepts in its placement origin, handle offsets and obstacles: a
+/// thousand kilometres, far beyond any cloth, and far from overflow when squared.
+pub const MAX_COORDINATE: f64 = 1e6;
+
+/// The largest component of the placement axes `u` and `v` (they scale the rest layout into the initial state;
+/// unit vectors place it unstretched).
+pub const MAX_AXIS: f64 = 1e3;
+
+/// The largest gravity magnitude (m/s²) a scene accepts: a thousand times the Earth's, far beyond any cloth
+/// experiment, and small enough that the forces m g stay many orders of magnitude from overflow.
+pub const MAX_GRAVITY: f64 = 1e4;
+
+/// The most Newton iterations per step a scene may ask for (`solver.max_newton`): the default is 50; more than
+/// 10 000 only delays the report of a step that does not converge.
+pub const MAX_NEWTON: usize = 10_000;
 
 /// Names of the built-in scenes.
 pub const BUILTINS: [&str; 5] = ["stretch-x", "stretch-y", "drape-x", "drape-y", "hanging"];
@@ -337,8 +397,9 @@ pub fn builtin(name: &str) -> Option<Scene> {
 }
 
 impl Scene {
-    /// Parse scene JSON; `name` (the file) is used in error messages.
+    /// Parse scene JSON (a leading UTF-8 byte-order mark is skipped); `name` (the file) is used in error messages.
     pub fn from_json_str(text: &str, name: &str) -> Result<Scene, ShellError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         serde_json::from_str(text).map_err(|source| ShellError::Json {
             file: name.to_string(),
             source,
@@ -362,8 +423,16 @@ impl Scene {
         Ok((s, dir))
     }
 
-    /// Check values serde cannot (positive sizes and times); errors name the field.
+    /// Check values serde cannot (sizes, times, physical parameters, against their ranges and the documented
+    /// limits [`MAX_STEPS`], [`MAX_GRAVITY`], [`MAX_NEWTON`]); errors name the field.
     fn validate(&self, file: &str) -> Result<(), ShellError> {
+        self.validate_times(file)?;
+        self.validate_physics(file)?;
+        self.validate_geometry(file)
+    }
+
+    /// `duration`, `dt` (not larger than a positive duration), the step count and the handles' keyframe times.
+    fn validate_times(&self, file: &str) -> Result<(), ShellError> {
         let bad = |field: &str, msg: String| Err(ShellError::scene(file, field, msg));
         if !(self.duration >= 0.0 && self.duration.is_finite()) {
             return bad(
@@ -374,14 +443,75 @@ impl Scene {
         if !(self.dt > 0.0 && self.dt.is_finite()) {
             return bad("dt", format!("must be positive, got {}", self.dt));
         }
+        if self.dt < MIN_DT {
+            return bad(
+                "dt",
+                format!("{} s is below the limit of {MIN_DT:e} s", self.dt),
+            );
+        }
+        if self.duration > 0.0 && self.dt > self.duration {
+            return bad(
+                "dt",
+                format!(
+                    "{} s is larger than the duration {} s (one step would overshoot it)",
+                    self.dt, self.duration
+                ),
+            );
+        }
+        let steps = (self.duration / self.dt - 1e-9).ceil();
+        // finite duration ≥ 0 and dt > 0: a number or +inf, never NaN
+        if steps > MAX_STEPS as f64 {
+            return bad(
+                "dt",
+                format!(
+                    "duration / dt = {steps:e} steps is more than the limit of {MAX_STEPS} (a larger dt or a \
+                     shorter duration?)"
+                ),
+            );
+        }
+        for (i, h) in self.handles.iter().enumerate() {
+            if h.keyframes
+                .windows(2)
+                .any(|w| w[1].0.is_nan() || w[1].0 <= w[0].0)
+                || h.keyframes.iter().any(|k| !k.0.is_finite())
+            {
+                return bad(
+                    &format!("handles[{i}].keyframes"),
+                    "times must be finite and increase".into(),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Gravity (bounded by [`MAX_GRAVITY`]), drag, the model's scales, the solver and the contact parameters.
+    fn validate_physics(&self, file: &str) -> Result<(), ShellError> {
+        let bad = |field: &str, msg: String| Err(ShellError::scene(file, field, msg));
+        let g = self.gravity;
+        let gnorm = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
+        if gnorm.is_nan() || gnorm > MAX_GRAVITY {
+            return bad(
+                "gravity",
+                format!("magnitude {gnorm:e} m/s² is more than the limit of {MAX_GRAVITY:e} m/s²"),
+            );
+        }
+        if !(self.drag >= 0.0 && self.drag.is_finite()) {
+            return bad(
+                "drag",
+                format!("must be a non-negative rate (1/s), got {}", self.drag),
+            );
+        }
         let m = &self.model;
         for (f, v) in [("model.stiffness", m.stiffness), ("model.mass", m.mass)] {
             if !(v > 0.0 && v.is_finite()) {
                 return bad(f, format!("must be positive, got {v}"));
             }
         }
-        if !m.bending_scale.is_finite() {
-            return bad("model.bending_scale", "must be finite".into());
+        if !(m.bending_scale >= 0.0 && m.bending_scale.is_finite()) {
+            return bad(
+                "model.bending_scale",
+                format!("must be a non-negative number, got {}", m.bending_scale),
+            );
         }
         if self.solver.force_tol.is_nan() || self.solver.force_tol <= 0.0 {
             return bad(
@@ -389,32 +519,74 @@ impl Scene {
                 format!("must be positive, got {}", self.solver.force_tol),
             );
         }
-        if !(self.contact.thickness >= 0.0 && self.contact.stiffness >= 0.0) {
+        if self.solver.max_newton > MAX_NEWTON {
             return bad(
-                "contact",
-                "thickness and stiffness must be non-negative".into(),
+                "solver.max_newton",
+                format!(
+                    "{} is more than the limit of {MAX_NEWTON}",
+                    self.solver.max_newton
+                ),
+            );
+        }
+        let c = &self.contact;
+        for (f, v) in [
+            ("contact.thickness", c.thickness),
+            ("contact.stiffness", c.stiffness),
+        ] {
+            if !(v >= 0.0 && v.is_finite()) {
+                return bad(f, format!("must be a non-negative number, got {v}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The fabric angle, the placement, the handle offsets and the obstacles (bounded by [`MAX_COORDINATE`] and
+    /// [`MAX_AXIS`]).
+    fn validate_geometry(&self, file: &str) -> Result<(), ShellError> {
+        let bad = |field: &str, msg: String| Err(ShellError::scene(file, field, msg));
+        let within = |v: &[f64], limit: f64| v.iter().all(|x| x.abs() <= limit);
+        let pl = &self.placement;
+        if !within(&pl.origin, MAX_COORDINATE) {
+            return bad(
+                "placement.origin",
+                format!("coordinates must be within ±{MAX_COORDINATE:e} m"),
+            );
+        }
+        if !(within(&pl.u, MAX_AXIS) && within(&pl.v, MAX_AXIS)) {
+            return bad(
+                "placement",
+                format!("the components of u and v must be within ±{MAX_AXIS:e}"),
             );
         }
         for (i, h) in self.handles.iter().enumerate() {
-            if h.keyframes
-                .windows(2)
-                .any(|w| w[1].0.is_nan() || w[1].0 <= w[0].0)
-            {
+            if h.keyframes.iter().any(|k| !within(&k.1, MAX_COORDINATE)) {
                 return bad(
                     &format!("handles[{i}].keyframes"),
-                    "times must increase".into(),
+                    format!("offsets must be within ±{MAX_COORDINATE:e} m"),
                 );
             }
         }
+        if !self.fabric_angle_deg.is_finite() {
+            return bad("fabric_angle_deg", "must be finite".into());
+        }
         for (i, o) in self.obstacles.iter().enumerate() {
             let ok = match o {
-                Obstacle::Sphere { radius, .. } => *radius > 0.0,
-                Obstacle::Plane { normal, .. } => normal.iter().any(|&x| x != 0.0),
+                Obstacle::Sphere { center, radius } => {
+                    *radius > 0.0 && *radius <= MAX_COORDINATE && within(center, MAX_COORDINATE)
+                }
+                Obstacle::Plane { point, normal } if within(point, MAX_COORDINATE) => {
+                    let l = (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2])
+                        .sqrt();
+                    l > 0.0 && l.is_finite()
+                }
+                Obstacle::Plane { .. } => false,
             };
             if !ok {
                 return bad(
                     &format!("obstacles[{i}]"),
-                    "needs a positive radius / non-zero normal".into(),
+                    format!(
+                        "needs a positive radius / non-zero normal, coordinates within ±{MAX_COORDINATE:e} m"
+                    ),
                 );
             }
         }
@@ -470,26 +642,13 @@ impl Scene {
         let model = ElementModel::new(&material, &flags, self.psd);
         let mut pins = Vec::new();
         for (i, sel) in self.pins.iter().enumerate() {
-            let v = sel.select(&mesh);
-            if v.is_empty() {
-                return Err(ShellError::Selection {
-                    file: file.to_string(),
-                    field: format!("pins[{i}]"),
-                    problem: "selects no vertex",
-                });
-            }
-            pins.extend(v);
+            pins.extend(sel.select_checked(&mesh, file, format!("pins[{i}]"))?);
         }
         let mut handles = Vec::new();
         for (i, h) in self.handles.iter().enumerate() {
-            let v = h.select.select(&mesh);
-            if v.is_empty() {
-                return Err(ShellError::Selection {
-                    file: file.to_string(),
-                    field: format!("handles[{i}].select"),
-                    problem: "selects no vertex",
-                });
-            }
+            let v = h
+                .select
+                .select_checked(&mesh, file, format!("handles[{i}].select"))?;
             if v.iter().any(|x| pins.contains(x)) {
                 return Err(ShellError::Selection {
                     file: file.to_string(),

@@ -22,7 +22,7 @@
 //! p = δ − d > 0 into the layer of thickness δ around the surface (d the signed distance); C² at p = 0. Its
 //! Hessian keeps the PSD part 2 m k p n̂n̂ᵀ (the sphere's curvature term is negative and dropped).
 
-use super::assemble::{assemble, energy, Assembled, Pattern};
+use super::assemble::{assemble, energy, gather, Assembled, Pattern};
 use super::element::ElementModel;
 use super::mesh::Stencil;
 use super::ShellError;
@@ -186,6 +186,52 @@ pub fn strain_quantile(z: &[[f64; 6]], q: f64) -> [f64; 6] {
     out
 }
 
+/// An error when a quantity of step `step` (ending at `time`) is not finite: the run diverged
+/// ([`ShellError::NonFiniteState`]); a finite state is never reported as a result.
+fn check_finite(
+    step: usize,
+    time: f64,
+    quantity: &'static str,
+    value: f64,
+) -> Result<(), ShellError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(ShellError::NonFiniteState {
+            step,
+            time,
+            quantity,
+            value,
+        })
+    }
+}
+
+/// When the elastic energy at `x` is undefined, tell a material that does not evaluate to a finite energy at a
+/// triangle's strain apart from a degenerate triangle: the first triangle whose strain is defined but whose
+/// energy is not, as [`ShellError::NonFiniteMaterial`] (`None` when every such triangle is degenerate). Only
+/// called on the error path.
+fn non_finite_material(
+    model: &ElementModel,
+    stencils: &[Stencil],
+    x: &[f64],
+    step: Option<usize>,
+) -> Option<ShellError> {
+    stencils.iter().enumerate().find_map(|(t, s)| {
+        let q = gather(s, x);
+        let z = model
+            .strain(&q, &s.rest, s.flaps)
+            .filter(|z| z.iter().all(|v| v.is_finite()))?;
+        model
+            .energy(&q, &s.rest, s.flaps)
+            .is_none()
+            .then_some(ShellError::NonFiniteMaterial {
+                triangle: t,
+                z,
+                step,
+            })
+    })
+}
+
 /// A running simulation.
 pub struct Simulation {
     pub model: ElementModel,
@@ -274,7 +320,8 @@ impl Simulation {
             .map_err(|source| ShellError::Symbolic { source })?;
         let x: Vec<f64> = x0.iter().flatten().copied().collect();
         if energy(&model, &stencils, &x).is_none() {
-            return Err(ShellError::DegenerateInitial);
+            return Err(non_finite_material(&model, &stencils, &x, None)
+                .unwrap_or(ShellError::DegenerateInitial));
         }
         Ok(Simulation {
             model,
@@ -364,11 +411,19 @@ impl Simulation {
         let h = self.settings.dt;
         let t1 = self.time + h;
         let (tg, x) = self.start_of_step(t1);
-        let phi = self.potential(&x, &tg).ok_or(ShellError::DegenerateStart {
-            step: self.steps + 1,
-            time: t1,
-        })?;
+        let step = self.steps + 1;
+        let phi = match self.potential(&x, &tg) {
+            Some(phi) => phi,
+            None => {
+                return Err(
+                    non_finite_material(&self.model, &self.stencils, &x, Some(step))
+                        .unwrap_or(ShellError::DegenerateStart { step, time: t1 }),
+                )
+            }
+        };
         let m = self.minimise(x, &tg, phi)?;
+        check_finite(step, t1, "largest residual force", m.residual)?;
+        check_finite(step, t1, "elastic energy", m.asm.energy)?;
         // reactions: the full gradient of Φ at the handle vertices (`asm` and `g_full` are evaluated at x,
         // except after a failed line search, where x did not change either)
         let handle_forces = self.handle_forces(&m.g_full);
@@ -385,6 +440,13 @@ impl Simulation {
         self.time = t1;
         self.steps += 1;
         let (ek, eg, eo) = self.energies();
+        for (what, v) in [
+            ("kinetic energy", ek),
+            ("gravitational energy", eg),
+            ("obstacle energy", eo),
+        ] {
+            check_finite(step, t1, what, v)?;
+        }
         let asm = m.asm;
         Ok(StepReport {
             step: self.steps,
@@ -619,8 +681,10 @@ impl Simulation {
             true,
             self.exact_first(),
         )
-        .ok_or(ShellError::Degenerate {
-            step: self.steps + 1,
+        .ok_or_else(|| {
+            let step = self.steps + 1;
+            non_finite_material(&self.model, &self.stencils, x, Some(step))
+                .unwrap_or(ShellError::Degenerate { step })
         })?;
         let mut g = std::mem::take(&mut asm.grad);
         for v in 0..self.pattern.n {

@@ -5,7 +5,7 @@ use super::{Event, WorkflowError};
 use crate::shell::render::{sphere_mesh, write_png, Layer, View};
 use crate::shell::scene::{run, MeshSpec, RunSummary, Scene};
 use crate::shell::solver::Obstacle;
-use crate::shell::Psd;
+use crate::shell::{Psd, ShellError};
 use std::path::{Path, PathBuf};
 
 /// Overrides of a scene's settings (each `None`/`false` keeps the scene's).
@@ -144,6 +144,19 @@ pub fn snapshot(path: &Path, scene: &Scene, o: &Outcome) -> Result<(), WorkflowE
         });
     }
     Ok(write_png(path, &layers, &View::default())?)
+}
+
+/// Whether `e` is a simulation that diverged (a non-finite residual or energy, [`ShellError::NonFiniteState`]):
+/// the computation did not converge (exit code 3), as opposed to bad input (exit code 2).
+pub fn diverged(e: &WorkflowError) -> bool {
+    matches!(e, WorkflowError::Shell(ShellError::NonFiniteState { .. }))
+}
+
+/// Whether a finished run is complete (`05-macro.md`, exit codes of `hylc simulate`): its last step converged
+/// (steps before it may end at the Newton cap — they are counted in the summary — but the final state must be a
+/// converged step). A run of zero steps is complete.
+pub fn complete(s: &RunSummary) -> bool {
+    s.last.as_ref().is_none_or(|r| r.converged)
 }
 
 /// One-line summary of a finished run.

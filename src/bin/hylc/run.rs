@@ -4,12 +4,15 @@
 use crate::args::ConstructionArg;
 use crate::printer::Printer;
 use hylc::workflow::pipeline::{self, RunConfig};
+use hylc::workflow::simulate::diverged;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// The main job end to end: generate a stockinette (or the given patterns), compute its reference state, run the
 /// quick sampling plan and a 27-point held-out grid, fit the material, drape a cloth with it; prints a summary
-/// and writes everything to the output folder. A rerun resumes (finished samples are kept).
+/// and writes everything to the output folder. A rerun resumes (finished samples are kept). Exit code 0:
+/// complete (drape steps at the Newton cap are a note); 2: bad input; 3: the drape diverged (a non-finite residual
+/// or energy).
 #[derive(clap::Args)]
 pub struct Args {
     /// output folder
@@ -55,6 +58,13 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         construction: a.construction.map(Into::into),
     };
     let mut printer = Printer::default();
-    pipeline::run(&config, &mut |e| printer.show(e))?;
-    Ok(ExitCode::SUCCESS)
+    match pipeline::run(&config, &mut |e| printer.show(e)) {
+        Ok(_) => Ok(ExitCode::SUCCESS),
+        // the drape diverged: the computation did not converge (exit 3); steps at the Newton cap are only a note
+        Err(e) if diverged(&e) => {
+            eprintln!("error: {e}");
+            Ok(ExitCode::from(3))
+        }
+        Err(e) => Err(e.into()),
+    }
 }

@@ -4,12 +4,16 @@
 use crate::printer::Printer;
 use clap::ValueEnum;
 use hylc::shell::Psd;
-use hylc::workflow::simulate::{execute, prepare, snapshot, summary_line, Overrides};
+use hylc::workflow::simulate::{
+    complete, diverged, execute, prepare, snapshot, summary_line, Overrides,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Simulate a cloth scene: a scene JSON file or a built-in (stretch-x, stretch-y, drape-x, drape-y, hanging).
-/// Writes frame_NNNN.obj per frame and log.jsonl (one JSON object per step) to the output folder.
+/// Writes frame_NNNN.obj per frame and log.jsonl (one JSON object per step) to the output folder. Exit code 0:
+/// complete (the last step converged); 2: bad input; 3: did not converge (the last step ended at the Newton cap,
+/// or a residual or energy became non-finite, which stops the run).
 #[derive(clap::Args)]
 pub struct Args {
     /// scene JSON file or built-in name
@@ -84,7 +88,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let mut printer = Printer::new(a.quiet);
-    let o = execute(&scene, &a.scene, &dir, &a.out, &mut |e| printer.show(e))?;
+    let o = match execute(&scene, &a.scene, &dir, &a.out, &mut |e| printer.show(e)) {
+        Ok(o) => o,
+        Err(e) if diverged(&e) => {
+            eprintln!("error: {e}");
+            return Ok(ExitCode::from(3));
+        }
+        Err(e) => return Err(e.into()),
+    };
     println!("{}", summary_line(&o.summary));
     if let Some(r) = &o.summary.last {
         for (name, f) in &r.handle_forces {
@@ -101,5 +112,13 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let png = a.out.join("snapshot.png");
     snapshot(&png, &scene, &o)?;
     println!("wrote {} (the final state)", png.display());
+    if !complete(&o.summary) {
+        eprintln!(
+            "error: the last step did not converge (residual {:.2e} N above the force tolerance): the final state is \
+             not an equilibrium of its step",
+            o.summary.last.as_ref().map_or(f64::NAN, |r| r.residual)
+        );
+        return Ok(ExitCode::from(3));
+    }
     Ok(ExitCode::SUCCESS)
 }
