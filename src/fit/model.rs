@@ -208,6 +208,11 @@ pub fn strain6(z: &[f64; 5]) -> [f64; 6] {
 /// the value ([`check_records`]).
 pub const MAX_SAMPLE_VALUE: f64 = 1e12;
 
+/// Whether a Ψ̄ or stress value may enter a fit: finite, |v| ≤ [`MAX_SAMPLE_VALUE`].
+fn admissible_value(v: f64) -> bool {
+    v.is_finite() && v.abs() <= MAX_SAMPLE_VALUE
+}
+
 /// Check the records of one sample file before a fit: every Ψ̄ and stress component present is finite with
 /// magnitude at most [`MAX_SAMPLE_VALUE`], every strain finite, and an id given twice carries the same result
 /// both times (same z, status, Ψ̄ and stresses; such an identical duplicate is fitted once, a differing one is
@@ -223,7 +228,7 @@ pub fn check_records(records: &[Record]) -> Result<(), FitError> {
         if let Some(v) = r.z.iter().find(|v| !v.is_finite()) {
             return Err(bad(r, "z", format!("{v} is not finite")));
         }
-        if let Some(p) = r.psi.filter(|p| !(p.abs() <= MAX_SAMPLE_VALUE)) {
+        if let Some(p) = r.psi.filter(|&p| !admissible_value(p)) {
             return Err(bad(
                 r,
                 "psi",
@@ -233,7 +238,7 @@ pub fn check_records(records: &[Record]) -> Result<(), FitError> {
         let stress = r.stress.iter().flatten().enumerate();
         if let Some((k, v)) = stress
             .filter_map(|(k, v)| v.map(|v| (k, v)))
-            .find(|(_, v)| !(v.abs() <= MAX_SAMPLE_VALUE))
+            .find(|&(_, v)| !admissible_value(v))
         {
             return Err(bad(
                 r,
