@@ -15,7 +15,10 @@ pub use fit1d::{
 };
 pub use fit2d::{fit2d, Fit2D, Fit2DOptions, Fit2DReport};
 pub use mls::{Mls1D, Mls2D};
-pub use model::{fit_material, model_error, FitOptions, FitReport, MaterialFit, ModelError};
+pub use model::{
+    check_records, fit_material, model_error, FitOptions, FitReport, MaterialFit, ModelError,
+    MAX_SAMPLE_VALUE,
+};
 pub use plot::PlotError;
 
 /// Why a fit could not be made. Bad input is reported, never a panic.
@@ -33,6 +36,32 @@ pub enum FitError {
     /// the knot rule left fewer than two knots, or the minimum knot is missing
     #[error("knot placement failed: {0}")]
     Knots(String),
+    /// one term of a whole-material fit failed (`term` names it: `1D term 0 (s_x)`, `2D term (s_x, s_a)`)
+    #[error("{term}: {source}")]
+    Term { term: String, source: Box<FitError> },
+    /// the fitted model came out with a non-finite number (named), so no material is written
+    #[error("the fit did not converge: {0} is not finite")]
+    NotFinite(String),
+    /// a sample record that cannot be fitted: its id, the field and what is wrong
+    #[error("sample {id}: {field}: {message}")]
+    BadRecord {
+        id: String,
+        field: String,
+        message: String,
+    },
+}
+
+impl FitError {
+    /// Whether the fit did not converge (the computation, not the input, is at fault): too few samples converged
+    /// ([`FitError::TooFewSamples`], directly or for one term) or the model came out non-finite
+    /// ([`FitError::NotFinite`]). `hylc fit` exits with code 3 then.
+    pub fn is_not_converged(&self) -> bool {
+        match self {
+            FitError::TooFewSamples { .. } | FitError::NotFinite(_) => true,
+            FitError::Term { source, .. } => source.is_not_converged(),
+            _ => false,
+        }
+    }
 }
 
 /// Relative errors of fitted values against data: √(Σ e²)/√(Σ y²) and max |e| / max |y| (absolute when the data

@@ -101,6 +101,24 @@ pub struct ModelError {
     pub worst: Option<([f64; 5], f64, f64)>,
 }
 
+impl ModelError {
+    /// The first non-finite error (`rms_rel`, `max_rel`), by name.
+    fn non_finite(&self) -> Option<&'static str> {
+        [("rms_rel", self.rms_rel), ("max_rel", self.max_rel)]
+            .into_iter()
+            .find(|(_, v)| !v.is_finite())
+            .map(|(name, _)| name)
+    }
+
+    /// [`FitError::NotFinite`] naming `what` when an error is not finite.
+    pub fn check_finite(&self, what: &str) -> Result<(), FitError> {
+        match self.non_finite() {
+            Some(name) => Err(FitError::NotFinite(format!("{what} {name}"))),
+            None => Ok(()),
+        }
+    }
+}
+
 /// One 1D term's report.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Term1DReport {
@@ -182,6 +200,72 @@ pub fn strain6(z: &[f64; 5]) -> [f64; 6] {
     [z[0], z[1], z[2], z[3], 0.0, z[4]]
 }
 
+/// The largest |Ψ̄| (J/m²) and |∂Ψ̄/∂z_k| (J/m² per unit strain; J/m per 1/m for bending) a sample record may
+/// carry into a fit. The default yarn (E = 1 MPa, r = 1 mm) gives Ψ̄ of order 10⁻²–10 J/m² over the design's
+/// ranges, and yarns 10⁵ times stiffer stay below 10⁷; 10¹² leaves ample room while keeping every sum of squares
+/// the fit forms (10²⁴ per sample, at most 10⁶ samples per plan) far from overflow, so a fit never turns finite
+/// data into NaN. Larger values (a corrupted or hand-edited file) are an error naming the file, the sample and
+/// the value ([`check_records`]).
+pub const MAX_SAMPLE_VALUE: f64 = 1e12;
+
+/// Whether a Ψ̄ or stress value may enter a fit: finite, |v| ≤ [`MAX_SAMPLE_VALUE`].
+fn admissible_value(v: f64) -> bool {
+    v.is_finite() && v.abs() <= MAX_SAMPLE_VALUE
+}
+
+/// Check the records of one sample file before a fit: every Ψ̄ and stress component present is finite with
+/// magnitude at most [`MAX_SAMPLE_VALUE`], every strain finite, and an id given twice carries the same result
+/// both times (same z, status, Ψ̄ and stresses; such an identical duplicate is fitted once, a differing one is
+/// an error naming the id).
+pub fn check_records(records: &[Record]) -> Result<(), FitError> {
+    let bad = |r: &Record, field: &str, message: String| FitError::BadRecord {
+        id: r.id.clone(),
+        field: field.to_string(),
+        message,
+    };
+    let mut seen: std::collections::HashMap<&str, &Record> = std::collections::HashMap::new();
+    for r in records {
+        if let Some(v) = r.z.iter().find(|v| !v.is_finite()) {
+            return Err(bad(r, "z", format!("{v} is not finite")));
+        }
+        if let Some(p) = r.psi.filter(|&p| !admissible_value(p)) {
+            return Err(bad(
+                r,
+                "psi",
+                format!("Ψ̄ = {p:e} J/m² is not finite or beyond ±{MAX_SAMPLE_VALUE:e}"),
+            ));
+        }
+        let stress = r.stress.iter().flatten().enumerate();
+        if let Some((k, v)) = stress
+            .filter_map(|(k, v)| v.map(|v| (k, v)))
+            .find(|&(_, v)| !admissible_value(v))
+        {
+            return Err(bad(
+                r,
+                &format!("stress[{k}]"),
+                format!("{v:e} is not finite or beyond ±{MAX_SAMPLE_VALUE:e}"),
+            ));
+        }
+        if let Some(first) = seen.insert(r.id.as_str(), r) {
+            let same = first.z == r.z
+                && first.status == r.status
+                && first.psi.map(f64::to_bits) == r.psi.map(f64::to_bits)
+                && first.stress == r.stress;
+            if !same {
+                return Err(bad(
+                    r,
+                    "id",
+                    format!(
+                        "listed twice with different results (Ψ̄ {:?} and {:?}, status {:?} and {:?})",
+                        first.psi, r.psi, first.status, r.status
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Error of `material` at the converged records (failed ones counted as excluded).
 pub fn model_error<'a>(
     material: &Material,
@@ -191,7 +275,7 @@ pub fn model_error<'a>(
     let mut err = super::RelError::default();
     let mut compared = Vec::new();
     for r in records {
-        let Some(psi) = r.psi.filter(|v| v.is_finite()) else {
+        let Some(psi) = r.converged_psi() else {
             n_excluded += 1;
             continue;
         };
@@ -241,12 +325,15 @@ impl<'a> ByIndex<'a> {
 
     /// Ψ̄ of sample `i` (NaN when missing or failed).
     fn psi(&self, i: usize) -> f64 {
-        self.records[i].and_then(|r| r.psi).unwrap_or(f64::NAN)
+        self.records[i]
+            .and_then(Record::converged_psi)
+            .unwrap_or(f64::NAN)
     }
 
     /// The stress dΨ̄/dX of sample `i` along strain `k` in normalised units X = z_k/σ (NaN when missing).
     fn stress(&self, i: usize, k: usize, sigma: f64) -> f64 {
         self.records[i]
+            .filter(|r| r.converged_psi().is_some())
             .and_then(|r| r.stress)
             .and_then(|s| s[k])
             .map_or(f64::NAN, |d| d * sigma)
@@ -314,12 +401,9 @@ fn fit_terms1d(
             .map(|&i| by_index.stress(i, k, sigma[k]))
             .collect();
         let o = options_1d(k, opts);
-        let fit = fit1d_with_stress(&x, &psi, Some(&stress), &o).map_err(|e| {
-            FitError::BadOption(format!(
-                "1D term {} ({}): {e}",
-                k,
-                StrainComponent::NAMES[k]
-            ))
+        let fit = fit1d_with_stress(&x, &psi, Some(&stress), &o).map_err(|e| FitError::Term {
+            term: format!("1D term {} ({})", k, StrainComponent::NAMES[k]),
+            source: Box::new(e),
         })?;
         fits1d.push((k, fit, TermData { x, y: vec![], psi }));
     }
@@ -337,10 +421,10 @@ fn constant_term(
     let sa_range = plan.range_1d(1);
     let on_sa = present
         .iter()
-        .any(|r| sa_range.contains(&r.index) && r.psi.is_some_and(f64::is_finite));
+        .any(|r| sa_range.contains(&r.index) && r.converged_psi().is_some());
     let nearest = present
         .iter()
-        .filter(|r| r.psi.is_some_and(f64::is_finite) && (!on_sa || sa_range.contains(&r.index)))
+        .filter(|r| r.converged_psi().is_some() && (!on_sa || sa_range.contains(&r.index)))
         .map(|r| {
             let d: f64 = (0..5).map(|k| (r.z[k] / sigma[k]).powi(2)).sum();
             (d, *r)
@@ -350,7 +434,7 @@ fn constant_term(
             usable: 0,
             needed: 1,
         })?;
-    Ok((nearest.1.psi.unwrap_or(0.0), nearest.1.z))
+    Ok((nearest.1.converged_psi().unwrap_or(0.0), nearest.1.z))
 }
 
 /// FIT2D's options for the pair (k0, k1), k0 < k1: (s_x, s_y) neither quasi-convexified nor zero-compressed, a
@@ -403,12 +487,13 @@ fn fit_terms2d(
         let y: Vec<f64> = idx.iter().map(|&i| samples[i].z[k1] / sigma[k1]).collect();
         let psi: Vec<f64> = idx.iter().map(|&i| by_index.psi(i)).collect();
         let o = options_2d(k0, k1, opts);
-        let fit = fit2d(&x, &y, &psi, &o).map_err(|e| {
-            FitError::BadOption(format!(
-                "2D term ({}, {}): {e}",
+        let fit = fit2d(&x, &y, &psi, &o).map_err(|e| FitError::Term {
+            term: format!(
+                "2D term ({}, {})",
                 StrainComponent::NAMES[k0],
                 StrainComponent::NAMES[k1]
-            ))
+            ),
+            source: Box::new(e),
         })?;
         fits2d.push((k0, k1, fit, TermData { x, y, psi }));
     }
@@ -487,6 +572,35 @@ fn term_reports(
     (terms1d, terms2d)
 }
 
+impl FitReport {
+    /// [`FitError::NotFinite`] naming the first non-finite number among the constant f₀, the fit and model errors
+    /// of every term, of all samples and of the held-out samples: never a NaN in a report of a successful fit.
+    pub fn check_finite(&self) -> Result<(), FitError> {
+        if !self.constant.is_finite() {
+            return Err(FitError::NotFinite("the constant f₀".into()));
+        }
+        for t in &self.terms1d {
+            let what = format!("1D term {}", t.strain.name());
+            if !(t.fit_rms_rel.is_finite() && t.fit_max_rel.is_finite()) {
+                return Err(FitError::NotFinite(format!("{what}: its fit error")));
+            }
+            t.model.check_finite(&format!("{what}: model"))?;
+        }
+        for t in &self.terms2d {
+            let what = format!("2D term ({}, {})", t.strains[0].name(), t.strains[1].name());
+            if !(t.fit_rms_rel.is_finite() && t.fit_max_rel.is_finite()) {
+                return Err(FitError::NotFinite(format!("{what}: its fit error")));
+            }
+            t.model.check_finite(&format!("{what}: model"))?;
+        }
+        self.all.check_finite("all samples: model")?;
+        if let Some(h) = &self.holdout {
+            h.check_finite("held-out samples: model")?;
+        }
+        Ok(())
+    }
+}
+
 /// The material's `meta` block: `meta` completed with the plan hash, the fit options and the fit errors.
 fn meta_block(
     mut meta: serde_json::Map<String, serde_json::Value>,
@@ -544,7 +658,11 @@ pub fn fit_material(
     let n = plan.len();
     let by_index = ByIndex::new(plan, records, &hash)?;
     let present = by_index.present();
-    let converged = present.iter().filter(|r| r.psi.is_some()).count();
+    check_records(records)?;
+    let converged = present
+        .iter()
+        .filter(|r| r.converged_psi().is_some())
+        .count();
     let samples = plan.samples();
     let sigma = strain_scales(&samples);
 
@@ -579,6 +697,7 @@ pub fn fit_material(
         compare_1d: None,
     };
 
+    report.check_finite()?;
     let meta = meta_block(meta, opts, &report);
     material.extra.insert(
         "strain shift".into(),
@@ -643,7 +762,7 @@ pub fn compare_1d(
     let mut psi = vec![None; plan.len()];
     for r in records {
         if r.index < psi.len() {
-            psi[r.index] = r.psi;
+            psi[r.index] = r.converged_psi();
         }
     }
     let rel = |num: f64, den: f64| (num / den.max(1e-300)).sqrt();

@@ -44,6 +44,48 @@ pub fn sample_range(k: usize, z_min: f64, z_max: f64, n: usize) -> Vec<f64> {
     }
 }
 
+/// The most samples a plan may have (1D ranges, 2D grids and in-plane grid together), and so the largest any one
+/// count (`count_1d`, `count_2d`, an entry of `counts_1d` / `counts_2d`, an axis of `grid`) may be. The design's
+/// default plan has 23 250 samples; 10⁶ is 43 times that, weeks of solves on a workstation, while the enumeration
+/// ([`Plan::samples`], about 100 bytes a sample) stays near 100 MB. Checked (with overflow-free arithmetic) by
+/// [`Plan::validate`] before anything is allocated.
+pub const MAX_PLAN_SAMPLES: usize = 1_000_000;
+
+/// The largest stretch s_x, s_y a plan may sample (a stretch ratio of 4). The built-in plans reach 0.96, the
+/// in-plane grid 1.0 and the plans under `validation/plans/` 0.99; beyond a ratio of about 2 a yarn-level pattern
+/// has straightened its yarns and only stretches the yarns themselves (orders of magnitude stiffer), so larger
+/// values only make the solves long or fail. The lower limit of a stretch is −1 (exclusive): zero length.
+pub const MAX_PLAN_STRETCH: f64 = 3.0;
+
+/// |s_a| must stay below this (exclusive): s_a is the cosine of the angle between the deformed warp and weft
+/// directions, so |s_a| = 1 folds them onto one line. The built-in plans reach 0.7, `validation/plans/` 0.75.
+pub const MAX_PLAN_SHEAR: f64 = 1.0;
+
+/// The largest |Π₀₀|, |Π₁₁| (1/m) a plan may sample: a radius of curvature of 1 mm, about a period of the
+/// patterns (a cloth bent tighter folds onto itself). The built-in plans reach 160 m⁻¹, `validation/plans/` 230.
+pub const MAX_PLAN_CURVATURE: f64 = 1000.0;
+
+/// Why value `v` of strain `k` (0..5: s_x, s_a, s_y, Π₀₀, Π₁₁) is not admissible in a plan, if it is not: finite,
+/// stretches in (−1, [`MAX_PLAN_STRETCH`]], |s_a| < [`MAX_PLAN_SHEAR`], |Π| ≤ [`MAX_PLAN_CURVATURE`].
+pub fn inadmissible(k: usize, v: f64) -> Option<String> {
+    let name = StrainComponent::NAMES[k];
+    if !v.is_finite() {
+        return Some(format!("{name} = {v} is not finite"));
+    }
+    match k {
+        0 | 2 if v <= -1.0 || v > MAX_PLAN_STRETCH => Some(format!(
+            "{name} = {v} is outside the admissible stretches (−1, {MAX_PLAN_STRETCH}]"
+        )),
+        1 if v.abs() >= MAX_PLAN_SHEAR => Some(format!(
+            "{name} = {v} is outside the admissible shears (−{MAX_PLAN_SHEAR}, {MAX_PLAN_SHEAR})"
+        )),
+        3 | 4 if v.abs() > MAX_PLAN_CURVATURE => Some(format!(
+            "{name} = {v} is outside the admissible curvatures [−{MAX_PLAN_CURVATURE}, {MAX_PLAN_CURVATURE}] 1/m"
+        )),
+        _ => None,
+    }
+}
+
 /// Per-strain ranges [min, max] (design defaults: s_x, s_y ∈ [−0.6, 0.96], s_a ∈ [−0.7, 0.7], Π ∈ [−160, 160]
 /// m⁻¹).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -134,7 +176,15 @@ impl InPlaneGrid {
 
     /// Number of grid points.
     pub fn len(&self) -> usize {
-        self.s_x.len() * self.s_a.len() * self.s_y.len()
+        self.checked_len().unwrap_or(usize::MAX)
+    }
+
+    /// Number of grid points, `None` when it overflows `usize`.
+    pub fn checked_len(&self) -> Option<usize> {
+        self.s_x
+            .len()
+            .checked_mul(self.s_a.len())?
+            .checked_mul(self.s_y.len())
     }
 
     /// Whether the grid has no points.
@@ -361,28 +411,102 @@ impl Plan {
 
     /// Sample indices of the 1D range of strain `k` (`k` = 5: the empty range after the last).
     pub fn range_1d(&self, k: usize) -> std::ops::Range<usize> {
-        let start: usize = (0..k).map(|j| self.n_1d(j)).sum();
-        start..start + if k < 5 { self.n_1d(k) } else { 0 }
+        let start = (0..k).fold(0usize, |n, j| n.saturating_add(self.n_1d(j)));
+        start..start.saturating_add(if k < 5 { self.n_1d(k) } else { 0 })
     }
 
     /// Sample indices of pair `p`'s grid, row-major (`p` = number of pairs: the empty range after the last).
     pub fn range_2d(&self, p: usize) -> std::ops::Range<usize> {
-        let start = self.range_1d(5).start
-            + (0..p)
-                .map(|q| {
-                    let [a, b] = self.n_2d(q);
-                    a * b
-                })
-                .sum::<usize>();
+        let start = (0..p).fold(self.range_1d(5).start, |n, q| {
+            let [a, b] = self.n_2d(q);
+            n.saturating_add(a.saturating_mul(b))
+        });
         let [a, b] = if p < self.pairs.len() {
             self.n_2d(p)
         } else {
             [0, 0]
         };
-        start..start + a * b
+        start..start.saturating_add(a.saturating_mul(b))
     }
 
-    /// Check ranges, counts and pairs.
+    /// The parts of the plan's enumeration with the field that sets each one's size: the 1D ranges (`count_1d` or
+    /// `counts_1d[k]`), the 2D grids (`count_2d` or `counts_2d[p]`) and the in-plane grid (`grid`); a size that
+    /// overflows `usize` is `None`.
+    fn parts(&self) -> Vec<(String, Option<usize>)> {
+        let mut parts: Vec<(String, Option<usize>)> = (0..5)
+            .map(|k| match self.counts_1d {
+                Some(_) => (format!("counts_1d[{k}]"), Some(self.n_1d(k))),
+                None => ("count_1d".to_string(), Some(self.count_1d)),
+            })
+            .collect();
+        for p in 0..self.pairs.len() {
+            let [a, b] = self.n_2d(p);
+            let field = match self.counts_2d {
+                Some(_) => format!("counts_2d[{p}]"),
+                None => "count_2d".to_string(),
+            };
+            parts.push((field, a.checked_mul(b)));
+        }
+        if let Some(g) = &self.grid {
+            parts.push(("grid".to_string(), g.checked_len()));
+        }
+        parts
+    }
+
+    /// Number of samples, `None` when it overflows `usize`.
+    pub fn checked_len(&self) -> Option<usize> {
+        self.parts()
+            .into_iter()
+            .try_fold(0usize, |n, (_, part)| n.checked_add(part?))
+    }
+
+    /// Check the counts against [`MAX_PLAN_SAMPLES`] (each count, then the total, in checked arithmetic): the
+    /// field at fault and the message.
+    fn validate_counts(&self) -> Result<(), (String, String)> {
+        let too_many = |n: String| {
+            format!("{n} samples: more than the limit of {MAX_PLAN_SAMPLES} samples per plan")
+        };
+        let mut counts: Vec<(String, usize)> = vec![("count_1d".into(), self.count_1d)];
+        counts.push(("count_2d".into(), self.count_2d));
+        if let Some(c) = &self.counts_1d {
+            counts.extend(
+                c.iter()
+                    .enumerate()
+                    .map(|(k, &n)| (format!("counts_1d[{k}]"), n)),
+            );
+        }
+        if let Some(c) = &self.counts_2d {
+            for (p, pair) in c.iter().enumerate() {
+                counts.extend(
+                    pair.iter()
+                        .enumerate()
+                        .map(|(s, &n)| (format!("counts_2d[{p}][{s}]"), n)),
+                );
+            }
+        }
+        if let Some(g) = &self.grid {
+            for (name, axis) in [("s_x", &g.s_x), ("s_a", &g.s_a), ("s_y", &g.s_y)] {
+                counts.push((format!("grid.{name}"), axis.len()));
+            }
+        }
+        if let Some((field, n)) = counts.into_iter().find(|(_, n)| *n > MAX_PLAN_SAMPLES) {
+            return Err((field, too_many(n.to_string())));
+        }
+        let mut total = 0usize;
+        for (field, part) in self.parts() {
+            match part.and_then(|n| total.checked_add(n)) {
+                Some(n) if n <= MAX_PLAN_SAMPLES => total = n,
+                Some(n) => return Err((field, too_many(format!("with this part, {n}")))),
+                None => return Err((field, too_many("with this part, more than 2⁶⁴".into()))),
+            }
+        }
+        Ok(())
+    }
+
+    /// Check ranges, counts and pairs: every range value and grid value admissible ([`inadmissible`]: stretches in
+    /// (−1, [`MAX_PLAN_STRETCH`]], |s_a| < [`MAX_PLAN_SHEAR`], |Π| ≤ [`MAX_PLAN_CURVATURE`]), every count and the
+    /// total at most [`MAX_PLAN_SAMPLES`] (`04-sampling-fitting.md`, "Sampling plan (C4)"). Every runner and
+    /// [`Plan::from_json`] call this before enumerating a sample.
     pub fn validate(&self) -> Result<(), PlanError> {
         let err = |field: String, message: String| PlanError {
             file: None,
@@ -397,11 +521,8 @@ impl Plan {
                     format!("[{lo}, {hi}] is not a finite range with min ≤ max"),
                 ));
             }
-            if (k == 0 || k == 2) && lo <= -1.0 {
-                return Err(err(
-                    format!("ranges.{name}"),
-                    format!("the lower end {lo} must be above −1 (a stretch)"),
-                ));
+            if let Some(m) = inadmissible(k, lo).or_else(|| inadmissible(k, hi)) {
+                return Err(err(format!("ranges.{name}"), m));
             }
             if (k == 1 || k >= 3) && (lo > 0.0 || hi < 0.0) {
                 return Err(err(
@@ -418,6 +539,7 @@ impl Plan {
                 ));
             }
         }
+        self.validate_counts().map_err(|(f, m)| err(f, m))?;
         if let Some(r2) = &self.ranges_2d {
             if r2.len() != self.pairs.len() {
                 return Err(err(
@@ -438,6 +560,9 @@ impl Plan {
                             ),
                         ));
                     }
+                    if let Some(m) = inadmissible(k, lo).or_else(|| inadmissible(k, hi)) {
+                        return Err(err(format!("ranges_2d[{p}][{side}]"), m));
+                    }
                 }
             }
         }
@@ -446,15 +571,12 @@ impl Plan {
                 if values.is_empty() {
                     return Err(err(format!("grid.{name}"), "empty".into()));
                 }
-                if let Some(v) = values.iter().find(|v| {
-                    !v.is_finite()
-                        || (name == "s_a" && v.abs() >= 1.0)
-                        || (name != "s_a" && **v <= -1.0)
-                }) {
-                    return Err(err(
-                        format!("grid.{name}"),
-                        format!("{v} is not an admissible value (stretches > −1, |s_a| < 1)"),
-                    ));
+                let k = StrainComponent::NAMES
+                    .iter()
+                    .position(|n| *n == name)
+                    .unwrap_or(0);
+                if let Some(m) = values.iter().find_map(|&v| inadmissible(k, v)) {
+                    return Err(err(format!("grid.{name}"), m));
                 }
             }
         }
@@ -492,6 +614,8 @@ impl Plan {
             field: field.to_string(),
             message,
         };
+        // a UTF-8 byte-order mark is accepted, as in `.pyp` files
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let value: serde_json::Value =
             serde_json::from_str(text).map_err(|e| err("-", format!("not JSON: {e}")))?;
         let obj = value
@@ -615,9 +739,10 @@ impl Plan {
         sample_range(k, lo, hi, self.n_2d(p)[side])
     }
 
-    /// Number of samples: the 1D ranges, the 2D grids and the in-plane grid's points.
+    /// Number of samples: the 1D ranges, the 2D grids and the in-plane grid's points (`usize::MAX` when that
+    /// overflows, which [`Plan::validate`] rejects).
     pub fn len(&self) -> usize {
-        self.grid_start() + self.grid.as_ref().map_or(0, InPlaneGrid::len)
+        self.checked_len().unwrap_or(usize::MAX)
     }
 
     /// Whether the plan has no samples.
@@ -636,7 +761,7 @@ impl Plan {
     /// row-major (index i of the first strain, j of the second: i · (second axis count) + j).
     pub fn samples(&self) -> Vec<Sample> {
         let hash = self.hash();
-        let mut zs: Vec<[f64; 5]> = Vec::with_capacity(self.len());
+        let mut zs: Vec<[f64; 5]> = Vec::with_capacity(self.len().min(MAX_PLAN_SAMPLES));
         for k in 0..5 {
             for v in self.axis_1d(k) {
                 let mut z = [0.0; 5];
@@ -965,6 +1090,152 @@ mod tests {
         for p in [uniform, per_range] {
             check_chains(&p);
         }
+    }
+
+    #[test]
+    fn huge_counts_are_rejected_before_any_allocation() {
+        let good = serde_json::to_value(Plan::reduced()).unwrap();
+        let big = serde_json::json!(u64::MAX);
+        let cases: Vec<(&str, serde_json::Value, &str)> = vec![
+            ("count_1d", big.clone(), "count_1d"),
+            ("count_1d", 1_000_000_000u64.into(), "count_1d"),
+            ("count_1d", (1u64 << 32).into(), "count_1d"),
+            // 5 × 200 001 > 10⁶: each count is within the limit, the total is not
+            ("count_1d", 200_001u64.into(), "count_1d"),
+            ("count_2d", 100_000u64.into(), "count_2d"),
+            ("count_2d", 1_000_000_000u64.into(), "count_2d"),
+            // 9 × 400² = 1 440 000
+            ("count_2d", 400u64.into(), "count_2d"),
+            (
+                "counts_1d",
+                serde_json::json!([3, 3, u64::MAX, 3, 3]),
+                "counts_1d[2]",
+            ),
+            (
+                "counts_2d",
+                {
+                    let mut c = vec![serde_json::json!([3, 3]); 9];
+                    c[4] = serde_json::json!([1u64 << 32, 1u64 << 32]);
+                    c.into()
+                },
+                "counts_2d[4][0]",
+            ),
+            (
+                "counts_2d",
+                {
+                    let mut c = vec![serde_json::json!([3, 3]); 9];
+                    c[7] = serde_json::json!([1000, 1001]);
+                    c.into()
+                },
+                "counts_2d[7]",
+            ),
+            (
+                "grid",
+                serde_json::json!({"s_x": vec![0.0; 101], "s_a": vec![0.0; 100], "s_y": vec![0.0; 100]}),
+                "grid",
+            ),
+        ];
+        for (key, value, field) in cases {
+            let mut v = good.clone();
+            v[key] = value;
+            let e = Plan::from_json(&v.to_string(), Some("big.json")).unwrap_err();
+            assert_eq!(e.field, field, "{e}");
+            assert!(e.to_string().contains("1000000 samples per plan"), "{e}");
+        }
+        // checked arithmetic: a plan built in code with overflowing counts has no length, and len() saturates
+        let p = Plan {
+            count_2d: usize::MAX,
+            ..Plan::reduced()
+        };
+        assert_eq!(p.checked_len(), None);
+        assert_eq!(p.len(), usize::MAX);
+        assert_eq!(p.validate().unwrap_err().field, "count_2d");
+        // the limit itself is admissible
+        let p = Plan {
+            count_1d: 200_000,
+            count_2d: 0,
+            pairs: vec![],
+            ..Plan::reduced()
+        };
+        assert_eq!(p.checked_len(), Some(MAX_PLAN_SAMPLES));
+        p.validate().unwrap();
+    }
+
+    #[test]
+    fn ranges_beyond_the_admissible_strains_are_rejected() {
+        let good = serde_json::to_value(Plan::reduced()).unwrap();
+        let cases: Vec<(&str, serde_json::Value, &str)> = vec![
+            ("/ranges/s_x", serde_json::json!([-0.5, 1e23]), "ranges.s_x"),
+            (
+                "/ranges/s_y",
+                serde_json::json!([-0.5, 1e300]),
+                "ranges.s_y",
+            ),
+            ("/ranges/s_y", serde_json::json!([-0.5, 3.5]), "ranges.s_y"),
+            (
+                "/ranges/II00",
+                serde_json::json!([-1e12, 1e12]),
+                "ranges.II00",
+            ),
+            (
+                "/ranges/II11",
+                serde_json::json!([-0.0, 1000.5]),
+                "ranges.II11",
+            ),
+            ("/ranges/s_a", serde_json::json!([-1e6, 1e6]), "ranges.s_a"),
+            ("/ranges/s_a", serde_json::json!([-1.0, 0.5]), "ranges.s_a"),
+            (
+                "/grid",
+                serde_json::json!({"s_x": [0.0, 5.0], "s_a": [0.0], "s_y": [0.0]}),
+                "grid.s_x",
+            ),
+        ];
+        for (pointer, value, field) in cases {
+            let mut v = good.clone();
+            if pointer == "/grid" {
+                v["grid"] = value;
+            } else {
+                *v.pointer_mut(pointer).unwrap() = value;
+            }
+            let e = Plan::from_json(&v.to_string(), Some("r.json")).unwrap_err();
+            assert_eq!(e.field, field, "{e}");
+            assert!(e.to_string().starts_with("r.json: plan field "), "{e}");
+        }
+        let mut p = Plan::reduced();
+        p.ranges_2d = Some(vec![[[-0.5, 0.5], [-0.5, 0.5]]; 9]);
+        p.validate().unwrap();
+        p.ranges_2d.as_mut().unwrap()[5][1] = [-2000.0, 0.0];
+        assert_eq!(p.validate().unwrap_err().field, "ranges_2d[5][1]");
+        // the limits themselves are admissible; every built-in plan is valid
+        p.ranges_2d = None;
+        p.ranges.s_x = [-0.99, MAX_PLAN_STRETCH];
+        p.ranges.ii00 = [-MAX_PLAN_CURVATURE, MAX_PLAN_CURVATURE];
+        p.ranges.s_a = [-0.999, 0.999];
+        p.validate().unwrap();
+        for p in [
+            Plan::default(),
+            Plan::reduced(),
+            Plan::quick(),
+            Plan::holdout(),
+        ] {
+            p.validate().unwrap();
+        }
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("validation/plans");
+        let mut n = 0;
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "json") {
+                Plan::load(&path).unwrap();
+                n += 1;
+            }
+        }
+        assert!(n >= 10);
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_accepted() {
+        let text = format!("\u{feff}{}", Plan::reduced().canonical_json());
+        assert_eq!(Plan::from_json(&text, None).unwrap(), Plan::reduced());
     }
 
     fn check_chains(p: &Plan) {

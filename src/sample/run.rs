@@ -60,6 +60,15 @@ pub struct Record {
     pub problem: String,
 }
 
+impl Record {
+    /// Ψ̄ when the sample counts as converged: status `Converged` and a finite Ψ̄. A `Stalled`, `MaxSteps` or
+    /// `TimeLimit` record may carry the Ψ̄ of its last iterate, which is not an equilibrium, so it is no sample.
+    pub fn converged_psi(&self) -> Option<f64> {
+        self.psi
+            .filter(|v| self.status == SampleStatus::Converged && v.is_finite())
+    }
+}
+
 /// How a sample's solve ended: the solver's [`Status`], or `Error` when it could not run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum SampleStatus {
@@ -145,7 +154,7 @@ pub fn parse_shard(text: &str) -> Result<(usize, usize), SampleError> {
     Ok((k, n))
 }
 
-/// Read a sample file: its records, in file order. A last line without its newline (an interrupted write) is
+/// Read a sample file: its records, in file order (a leading UTF-8 byte-order mark is skipped). A last line without its newline (an interrupted write) is
 /// ignored, and with `repair` cut off the file; any other unreadable line is an error naming file and line.
 pub fn read_samples(path: &Path, repair: bool) -> Result<Vec<Record>, SampleError> {
     let io = |action, source| SampleError::Io {
@@ -168,9 +177,17 @@ pub fn read_samples(path: &Path, repair: bool) -> Result<Vec<Record>, SampleErro
             .and_then(|_| f.sync_data())
             .map_err(|e| io("cannot cut off the truncated last line", e))?;
     }
-    let text = std::str::from_utf8(&text[..complete]).map_err(|e| SampleError::File {
-        path: path.to_path_buf(),
-        message: format!("not UTF-8 text: {e}"),
+    // a UTF-8 byte-order mark is accepted, as in `.pyp` files
+    let start = if text.starts_with(b"\xef\xbb\xbf") {
+        3
+    } else {
+        0
+    };
+    let text = std::str::from_utf8(&text[start.min(complete)..complete]).map_err(|e| {
+        SampleError::File {
+            path: path.to_path_buf(),
+            message: format!("not UTF-8 text: {e}"),
+        }
     })?;
     let mut out = Vec::new();
     for (i, line) in text.lines().enumerate() {
@@ -453,7 +470,7 @@ impl PlanRun<'_> {
             return false;
         }
         let n = self.written.fetch_add(1, Ordering::Relaxed) + 1;
-        if record.psi.is_some() {
+        if record.converged_psi().is_some() {
             self.converged.fetch_add(1, Ordering::Relaxed);
         }
         (self.progress)(n, self.todo);
@@ -554,6 +571,36 @@ mod tests {
         std::fs::write(&path, format!("{}\n{line}\n", &line[..20])).unwrap();
         let e = read_samples(&path, false).unwrap_err().to_string();
         assert!(e.contains("s.jsonl:1: not a sample record"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped_and_only_converged_records_count() {
+        let dir = std::env::temp_dir().join(format!("hylc-sample-bom-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("s.jsonl");
+        let mut r = Record {
+            id: "x-0".into(),
+            index: 0,
+            z: [0.1, 0.0, 0.0, 0.0, 0.0],
+            psi: Some(0.25),
+            stress: None,
+            status: SampleStatus::Converged,
+            error: None,
+            steps: 3,
+            gradient_norm: Some(1e-12),
+            time: 0.01,
+            start: SampleStart::Cold,
+            problem: "0".into(),
+        };
+        std::fs::write(&path, format!("\u{feff}{}", record_line(&r))).unwrap();
+        assert_eq!(read_samples(&path, true).unwrap(), vec![r.clone()]);
+        // a BOM alone (no complete line) is an empty file
+        std::fs::write(&path, "\u{feff}").unwrap();
+        assert_eq!(read_samples(&path, false).unwrap(), vec![]);
+        assert_eq!(r.converged_psi(), Some(0.25));
+        r.status = SampleStatus::MaxSteps;
+        assert_eq!(r.converged_psi(), None);
         std::fs::remove_dir_all(&dir).ok();
     }
 }

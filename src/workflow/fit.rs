@@ -4,7 +4,9 @@
 use super::inputs::load_plan;
 use super::sidecar::{meta_path, read_meta};
 use super::{write_file, Event, WorkflowError};
-use crate::fit::model::{compare_1d, fit_material, model_error, FitOptions, FitReport};
+use crate::fit::model::{
+    check_records, compare_1d, fit_material, model_error, FitOptions, FitReport,
+};
 use crate::fit::plot::plot_material_fit;
 use crate::material::Material;
 use crate::sample::{read_samples, Plan, Record};
@@ -165,7 +167,14 @@ pub fn fit_samples(
         if hr.is_empty() {
             return Err(WorkflowError::Input(format!("{}: no samples", h.display())));
         }
+        let fit_error = |source| WorkflowError::Fit {
+            samples: h.clone(),
+            source,
+        };
+        check_records(&hr).map_err(fit_error)?;
         let e = model_error(&fit.material, &hr);
+        e.check_finite("held-out samples: model")
+            .map_err(fit_error)?;
         if let Some(serde_json::Value::Object(m)) = fit.material.extra.get_mut("meta") {
             m.insert(
                 "holdout".into(),

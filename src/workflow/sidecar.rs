@@ -49,7 +49,10 @@ pub fn read_meta(
     let path = meta_path(samples);
     let bad = |what: String| WorkflowError::Input(format!("{}: {what}", path.display()));
     match std::fs::read_to_string(&path) {
-        Ok(text) => match serde_json::from_str::<serde_json::Value>(&text) {
+        // a UTF-8 byte-order mark is accepted, as in `.pyp` files
+        Ok(text) => match serde_json::from_str::<serde_json::Value>(
+            text.strip_prefix('\u{feff}').unwrap_or(&text),
+        ) {
             Ok(serde_json::Value::Object(m)) => Ok(Some(m)),
             Ok(_) => Err(bad("expected a JSON object".into())),
             Err(e) => Err(bad(format!("not JSON: {e}"))),

@@ -6,6 +6,7 @@ use clap::ValueEnum;
 use hylc::fit::model::FitOptions;
 use hylc::fit::SlopeSource;
 use hylc::workflow::fit::{fit_samples, FitJob};
+use hylc::workflow::WorkflowError;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -104,6 +105,9 @@ impl Args {
     }
 }
 
+/// `hylc fit`: exit code 0 when the material was written, 2 on bad input (including a sample record with a
+/// non-finite or absurd value, or an id listed twice with different results), 3 when the fit did not converge:
+/// too few samples of a term converged, or the model came out non-finite (nothing is written then).
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let beside = FitJob::beside(&a.samples);
     let job = FitJob {
@@ -119,6 +123,13 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         samples: a.samples,
     };
     let mut printer = Printer::default();
-    fit_samples(&job, &mut |e| printer.show(e))?;
-    Ok(ExitCode::SUCCESS)
+    match fit_samples(&job, &mut |e| printer.show(e)) {
+        Ok(_) => Ok(ExitCode::SUCCESS),
+        // too few samples converged for a term, or the model came out non-finite: nothing written, exit 3
+        Err(WorkflowError::Fit { samples, source }) if source.is_not_converged() => {
+            eprintln!("error: {}: {source}", samples.display());
+            Ok(ExitCode::from(3))
+        }
+        Err(e) => Err(e.into()),
+    }
 }
