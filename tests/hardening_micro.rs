@@ -276,6 +276,6 @@ fn the_originals_satisfy_every_limit() {
         "slip_stitch_honeycomb",
         "stockinette",
     ] {
-        Pattern::load_pyp(&data.join(format!("patterns/{name}.pyp"))).unwrap();
+        Pattern::load_pyp(data.join(format!("patterns/{name}.pyp"))).unwrap();
     }
 }
