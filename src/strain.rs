@@ -10,6 +10,17 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
+/// A number for an error message or a strain's display: Rust's shortest round-trip form, in exponent notation
+/// from |x| ≥ 1e15 on (so that 1e300 is not printed with 300 digits). No admissible strain is that large, so
+/// the display of valid strains is unchanged.
+pub fn compact(x: f64) -> String {
+    if x.is_finite() && x.abs() >= 1e15 {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 /// One of the five strain components of the micro problem, a sampling plan and a material's terms. Serialised
 /// (and parsed) by its name: `s_x`, `s_a`, `s_y`, `II00`, `II11`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]

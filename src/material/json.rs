@@ -5,6 +5,11 @@
 //! and written back; unknown keys inside "coeffs" and its terms are ignored. "strain shift", when present, must be
 //! the original's [1, 0, 1, 0, 0]: this library's z already holds s = λ − 1 (see `../shared/oracles/README.md`).
 //!
+//! Admissible values (checked at load, so that ψ, ∇ψ, ∇²ψ stay finite over the admissible strains of
+//! [`Material::eval_checked`]): density in [0, [`MAX_DENSITY`]]; strain scales in [[`MIN_STRAIN_SCALE`],
+//! [`MAX_STRAIN_SCALE`]]; knots within ±[`MAX_KNOT`], spaced at least [`MIN_KNOT_SPACING`]; the constant, values
+//! and slopes within ±[`MAX_COEFFICIENT`]. A leading UTF-8 byte-order mark is skipped.
+//!
 //! Every problem is reported as one line `FILE: FIELD: what is wrong`, never a panic. JSON has no NaN or infinity;
 //! the tokens `NaN`, `Infinity`, `-Infinity` and numbers that overflow f64 (which some writers emit) are recognised
 //! and reported at the field where they stand.
@@ -22,6 +27,25 @@ pub struct MaterialError {
     pub field: String,
     pub message: String,
 }
+
+/// Smallest admissible strain scale σ_k (every k; in-plane dimensionless, bending 1/m). The originals use 0.6–230;
+/// a sub-normal σ (5e-324) made z/σ infinite and ψ(0) NaN.
+pub const MIN_STRAIN_SCALE: f64 = 1e-6;
+/// Largest admissible strain scale σ_k: 1e6 (in 1/m for bending: the curvature of a 1 µm radius).
+pub const MAX_STRAIN_SCALE: f64 = 1e6;
+/// Largest admissible |knot| (normalised strain z/σ): the range [`super::MAX_NORMALISED_STRAIN`] of
+/// [`Material::eval_checked`] (the originals: |t| ≤ 0.95).
+pub const MAX_KNOT: f64 = super::MAX_NORMALISED_STRAIN;
+/// Smallest admissible knot spacing (normalised strain): the Hessian scales like 1/h², so knots scaled by 1e-300
+/// overflowed it. The originals' spacings are 0.0375 and more.
+pub const MIN_KNOT_SPACING: f64 = 1e-6;
+/// Largest admissible |value| of the constant, the spline values and slopes (J/m², per unit normalised strain):
+/// the originals reach 455. With [`MAX_KNOT`], [`MIN_KNOT_SPACING`] and the strain scale range this keeps ψ, ∇ψ
+/// and ∇²ψ finite over the admissible strains (slopes of ±1e308 gave NaN at z = 0).
+pub const MAX_COEFFICIENT: f64 = 1e12;
+/// Largest admissible areal density ρ_A (kg/m²): the originals are 0.31–0.50; a hundred-fold heavier cloth than
+/// any carpet is already 1e3 times the originals.
+pub const MAX_DENSITY: f64 = 1e3;
 
 type Res<T> = Result<T, (String, String)>;
 
@@ -177,17 +201,49 @@ fn knots(obj: &Map<String, Value>, key: &str, path: &str) -> Res<Vec<f64>> {
                 ),
             );
         }
+        if t[i] - t[i - 1] < MIN_KNOT_SPACING {
+            return err(
+                &format!("{p}[{i}]"),
+                format!(
+                    "knot spacing {:e} (from {:e} to {:e}) is below the minimum {MIN_KNOT_SPACING:e}",
+                    t[i] - t[i - 1],
+                    t[i - 1],
+                    t[i]
+                ),
+            );
+        }
+    }
+    if let Some(i) = t.iter().position(|x| x.abs() > MAX_KNOT) {
+        return err(
+            &format!("{p}[{i}]"),
+            format!("knot {:e} is outside [-{MAX_KNOT:e}, {MAX_KNOT:e}]", t[i]),
+        );
     }
     Ok(t)
 }
 
+/// A coefficient checked against [`MAX_COEFFICIENT`].
+fn coefficient(x: f64, path: &str) -> Res<f64> {
+    if x.abs() > MAX_COEFFICIENT {
+        return err(
+            path,
+            format!("|{x:e}| is above the largest admissible coefficient {MAX_COEFFICIENT:e}"),
+        );
+    }
+    Ok(x)
+}
+
 fn sized(obj: &Map<String, Value>, key: &str, path: &str, n: usize, what: &str) -> Res<Vec<f64>> {
     let v = numbers(obj, key, path)?;
+    let p = join(path, key);
     if v.len() != n {
         return err(
-            &join(path, key),
+            &p,
             format!("wrong array length {} (expected {n}, {what})", v.len()),
         );
+    }
+    for (i, &x) in v.iter().enumerate() {
+        coefficient(x, &format!("{p}[{i}]"))?;
     }
     Ok(v)
 }
@@ -197,6 +253,12 @@ fn parse_value(root: &Value) -> Res<Material> {
     let density = number(get(top, "density", "(top level)")?, "density")?;
     if density < 0.0 {
         return err("density", format!("must be ≥ 0, is {density}"));
+    }
+    if density > MAX_DENSITY {
+        return err(
+            "density",
+            format!("{density:e} kg/m² is above the largest admissible {MAX_DENSITY:e} kg/m²"),
+        );
     }
     let scale = numbers(top, "strain scale", "")?;
     if scale.len() != 5 {
@@ -210,6 +272,12 @@ fn parse_value(root: &Value) -> Res<Material> {
             return err(
                 &format!("strain scale[{i}]"),
                 format!("must be > 0, is {s}"),
+            );
+        }
+        if !(MIN_STRAIN_SCALE..=MAX_STRAIN_SCALE).contains(s) {
+            return err(
+                &format!("strain scale[{i}]"),
+                format!("{s:e} is outside [{MIN_STRAIN_SCALE:e}, {MAX_STRAIN_SCALE:e}]"),
             );
         }
     }
@@ -229,7 +297,10 @@ fn parse_value(root: &Value) -> Res<Material> {
         }
     }
     let coeffs = object(get(top, "coeffs", "(top level)")?, "coeffs")?;
-    let constant = number(get(coeffs, "const", "coeffs")?, "coeffs.const")?;
+    let constant = coefficient(
+        number(get(coeffs, "const", "coeffs")?, "coeffs.const")?,
+        "coeffs.const",
+    )?;
     let mut terms1d: Vec<Term1D> = Vec::new();
     for (i, e) in array(get(coeffs, "1D", "coeffs")?, "coeffs.1D")?
         .iter()
@@ -310,6 +381,8 @@ impl Material {
             field,
             message,
         };
+        // a leading UTF-8 byte-order mark (some editors write one) is not part of the JSON text
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let quoted = quote_non_finite(text);
         let root: Value = serde_json::from_str(&quoted).map_err(|e| {
             fail(

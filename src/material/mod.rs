@@ -21,6 +21,7 @@ use crate::real::Real;
 use hermite::{basis_piece, basis_weights, piece_from_index};
 use spectral::{spectral_00, spectral_00_reference};
 
+use crate::strain::compact;
 pub use crate::strain::{Strain6, StrainComponent};
 
 /// A 1D term f_k of the material: k is its strain (the file's index k = 0…4: s_x, s_a, s_y, Π₀₀, Π₁₁).
@@ -50,6 +51,31 @@ pub struct Material {
     pub terms2d: Vec<Term2D>,
     /// top-level keys other than density, strain scale and coeffs (e.g. "strain shift", "meta"), in file order
     pub extra: serde_json::Map<String, serde_json::Value>,
+}
+
+/// Largest admissible |z_k| / σ_k of [`Material::eval_checked`] (II₀₁ against σ₃ and σ₄): a thousand times
+/// the fitted range (the originals' knots span |z/σ| ≤ 0.95). Beyond the knots ψ continues linearly (the
+/// original's extrapolation), which means nothing physically a thousand ranges out; from about |z| = 1e150 the
+/// spectral terms' squares overflow and ψ becomes NaN. With the coefficient limits of [`json`] every ψ, ∇ψ, ∇²ψ
+/// inside this range is finite.
+pub const MAX_NORMALISED_STRAIN: f64 = 1e3;
+
+/// A strain outside a material's admissible range ([`Material::eval_checked`]).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum MaterialStrainError {
+    #[error("{component} = {} is not finite", compact(*value))]
+    NotFinite { component: &'static str, value: f64 },
+    #[error(
+        "{component} = {} is outside the material's admissible range |{component}| ≤ {limit:e} \
+         ({MAX_NORMALISED_STRAIN:e} strain scales σ = {scale})",
+        compact(*value)
+    )]
+    OutOfRange {
+        component: &'static str,
+        value: f64,
+        limit: f64,
+        scale: f64,
+    },
 }
 
 /// ψ, ∇ψ and ∇²ψ at one strain.
@@ -171,6 +197,34 @@ impl Material {
             }
         }
         out
+    }
+
+    /// The admissible range of the material: |z_k| ≤ [`MAX_NORMALISED_STRAIN`] σ_k for z = (s_x, s_a, s_y, II₀₀,
+    /// II₀₁, II₁₁), II₀₁ with the smaller of σ₃, σ₄ (it enters both bending terms).
+    pub fn admissible_limits(&self) -> [f64; 6] {
+        let sc = &self.strain_scale;
+        [sc[0], sc[1], sc[2], sc[3], sc[3].min(sc[4]), sc[4]].map(|s| s * MAX_NORMALISED_STRAIN)
+    }
+
+    /// [`Material::eval`] after checking that z is finite and within [`Material::admissible_limits`]; the
+    /// values are bitwise those of `eval`. The checked entry point for user-given strains (`hylc material`).
+    pub fn eval_checked(&self, z: &[f64; 6]) -> Result<PsiVgh, MaterialStrainError> {
+        let limits = self.admissible_limits();
+        for (k, (&value, &limit)) in z.iter().zip(&limits).enumerate() {
+            let component = Strain6::NAMES[k];
+            if !value.is_finite() {
+                return Err(MaterialStrainError::NotFinite { component, value });
+            }
+            if value.abs() > limit {
+                return Err(MaterialStrainError::OutOfRange {
+                    component,
+                    value,
+                    limit,
+                    scale: limit / MAX_NORMALISED_STRAIN,
+                });
+            }
+        }
+        Ok(self.eval(z))
     }
 
     /// ψ alone (same arithmetic as [`Material::eval`]).

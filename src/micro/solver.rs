@@ -111,6 +111,17 @@ pub enum MicroError {
         len: usize,
         expected: usize,
     },
+    /// The tile energy (or Ψ̄ = E / (p₁ p₂)) is infinite or NaN at an iterate: the pattern or the start state is
+    /// not physical (e.g. a rest length so small that the stretch energy overflows). Never reported as converged.
+    #[error(
+        "strain {strain}: the tile energy is {energy} J after {steps} Newton steps (not finite: the pattern or \
+         its start state is not physical)"
+    )]
+    NonFiniteEnergy {
+        strain: MacroStrain,
+        steps: usize,
+        energy: f64,
+    },
     /// A constraint row of [`MicroProblem::with_constraints`] that cannot be normalised.
     #[error("constraint row {row} is zero or not finite")]
     ConstraintRow { row: usize },
@@ -284,21 +295,41 @@ impl MicroProblem {
 
     /// Move a state to another strain at fixed ũ and θ: in steps small enough for the frame transport and the
     /// reference-twist continuation, switching between the `BendY` and `BendX` families at zero curvature.
+    /// The strain must pass [`MacroStrain::validate_for_radius`] with the pattern's radius.
     pub fn move_to(&self, state: &mut MicroState, target: &MacroStrain) -> Result<(), StrainError> {
-        let family = target.validate()?;
+        self.move_until(state, target, None).map(|_| ())
+    }
+
+    /// [`MicroProblem::move_to`], stopping between two moving steps once `deadline` (a start and a limit in
+    /// seconds) has passed; returns whether `state` reached `target` (if not, it stays at the last step's strain).
+    fn move_until(
+        &self,
+        state: &mut MicroState,
+        target: &MacroStrain,
+        deadline: Option<(Instant, f64)>,
+    ) -> Result<bool, StrainError> {
+        let family = target.validate_for_radius(self.pattern.radius)?;
         if family != state.family {
             // leave the current family at zero curvature, switch, continue
             let mut flat = state.strain;
             flat.0[3] = 0.0;
             flat.0[4] = 0.0;
-            self.move_within(state, &flat);
+            if !self.move_within(state, &flat, deadline) {
+                return Ok(false);
+            }
             self.switch_family(state, family);
         }
-        self.move_within(state, target);
-        Ok(())
+        Ok(self.move_within(state, target, deadline))
     }
 
-    fn move_within(&self, state: &mut MicroState, target: &MacroStrain) {
+    /// Move within the state's family (see [`MicroProblem::move_until`]); the number of steps is bounded by the
+    /// admissible strain set (`MAX_STRETCH`, `MAX_CURVATURE_RADIUS` in [`crate::micro::strain`]).
+    fn move_within(
+        &self,
+        state: &mut MicroState,
+        target: &MacroStrain,
+        deadline: Option<(Instant, f64)>,
+    ) -> bool {
         let from = state.strain;
         let pmax = self.pattern.periods[0].max(self.pattern.periods[1]);
         let dz = (0..3)
@@ -309,11 +340,14 @@ impl MicroProblem {
             .max((target.0[4] - from.0[4]).abs());
         let steps = ((dz / 0.05).max(dk * 2.0 * pmax / 0.25).ceil() as usize).max(1);
         if from == *target {
-            return;
+            return true;
         }
         let n = self.pattern.len();
         let mut old = Elimination::in_family(&self.pattern, &from, state.family);
         for s in 1..=steps {
+            if deadline.is_some_and(|(t0, limit)| t0.elapsed().as_secs_f64() > limit) {
+                return false;
+            }
             let t = s as f64 / steps as f64;
             let z = MacroStrain(std::array::from_fn(|k| {
                 if s == steps {
@@ -336,8 +370,9 @@ impl MicroProblem {
                 &new.transforms,
             );
             old = new;
+            state.strain = z;
         }
-        state.strain = *target;
+        true
     }
 
     /// Switch between `BendY` and `BendX` at zero curvature: a rotation Q about e₃ with Q F₂ = G₂ maps the plane
@@ -434,16 +469,40 @@ impl MicroProblem {
         start: Option<&MicroState>,
     ) -> Result<Solution, MicroError> {
         let t0 = Instant::now();
-        strain.validate()?;
+        strain.validate_for_radius(self.pattern.radius)?;
         let mut state = match start {
             Some(s) => s.clone(),
             None => self.reference_state(),
         };
-        self.move_to(&mut state, strain)?;
+        let deadline = self.options.time_limit.map(|limit| (t0, limit));
+        if !self.move_until(&mut state, strain, deadline)? {
+            return Ok(self.stopped_in_start_phase(state, t0));
+        }
         let start_time = t0.elapsed().as_secs_f64();
         let mut sol = self.newton(state, t0)?;
         sol.timings.start = start_time;
         Ok(sol)
+    }
+
+    /// The outcome of a solve whose time limit passed while moving the start state to its strain: status
+    /// `TimeLimit`, no Newton step, the state at the strain it reached, no energy evaluated (zero parts) and an
+    /// infinite gradient norm (nothing is known about equilibrium).
+    fn stopped_in_start_phase(&self, state: MicroState, t0: Instant) -> Solution {
+        let time = t0.elapsed().as_secs_f64();
+        Solution {
+            state,
+            status: Status::TimeLimit,
+            steps: 0,
+            energy: EnergyParts::default(),
+            gradient_norm: f64::INFINITY,
+            time,
+            timings: Timings {
+                start: time,
+                ..Timings::default()
+            },
+            area: self.pattern.periods[0] * self.pattern.periods[1],
+            max_mu: 0.0,
+        }
     }
 
     /// Newton iterations from a state already at its strain (the steps of the module documentation).
@@ -458,6 +517,13 @@ impl MicroProblem {
                 .evaluate(&state.frames, &state.y, Want::Hessian, &Terms::ALL)?;
             run.timings.assembly += ta.elapsed().as_secs_f64();
             let energy = ev.value();
+            if !(energy / run.area).is_finite() {
+                return Err(MicroError::NonFiniteEnergy {
+                    strain: state.strain,
+                    steps: run.steps,
+                    energy,
+                });
+            }
             let g = run.scaled_gradient(&ev);
             // 2. the force test uses the gradient projected on the constraint space (the constrained equilibrium
             // keeps a residual g = −Aᵀλ along the rows that are not exact symmetries, e.g. the yarn slides)

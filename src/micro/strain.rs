@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
+use crate::strain::compact;
 pub use crate::strain::StrainComponent;
 
 /// A macro strain z = (s_x, s_a, s_y, Π₀₀, Π₁₁): stretches along ξ₁ and ξ₂, the cosine of the angle between the
@@ -21,6 +22,28 @@ pub enum Family {
     BendY,
 }
 
+/// Smallest admissible stretch 1 + s_x, 1 + s_y: a tenth of the rest length. Every built-in sampling plan and
+/// every plan under `validation/plans` stays above 0.34 (s ≥ −0.66); below a tenth, the yarns of any pattern whose
+/// neighbours lie within ten radii of each other overlap across their whole cross-sections, and the start phase's
+/// displacement limit r λ_min(Ī) shrinks with the square of the stretch.
+pub const MIN_STRETCH: f64 = 0.1;
+
+/// Largest admissible stretch 1 + s_x, 1 + s_y: ten times the rest length. The plans reach 1.99 (s ≤ 0.99); a
+/// yarn-level tile pulled ten times its length is far past any yarn's breaking strain. The bound also bounds the
+/// work of the start phase, which moves a state to its strain in steps of at most 0.05 (at most 180 steps).
+pub const MAX_STRETCH: f64 = 10.0;
+
+/// Largest admissible |Π₀₀|, |Π₁₁| (1/m), whatever the pattern: the inverse of the smallest plausible yarn radius
+/// ([`crate::pattern::pyp::MIN_RADIUS`], 1 µm). The plans reach 230 1/m. A pattern's own, tighter bound is
+/// [`MAX_CURVATURE_RADIUS`] / r ([`MacroStrain::validate_for_radius`]).
+pub const MAX_CURVATURE: f64 = 1e6;
+
+/// Largest admissible |Π| r of a pattern of yarn radius r: the bending radius 1/|Π| may not be smaller than the
+/// yarn radius (the yarns of a tile, several radii thick, would be folded through themselves). The plans reach
+/// 230 1/m · 1 mm = 0.23 on the original patterns. The start phase moves curvature in steps of 0.125 / p_max, so
+/// this bound keeps it within 8 p_max / r steps.
+pub const MAX_CURVATURE_RADIUS: f64 = 1.0;
+
 /// A strain outside the set the micro solver supports.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("strain {strain}: {message}")]
@@ -32,11 +55,8 @@ pub struct StrainError {
 impl fmt::Display for MacroStrain {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let z = self.0;
-        write!(
-            f,
-            "(s_x {}, s_a {}, s_y {}, II00 {}, II11 {})",
-            z[0], z[1], z[2], z[3], z[4]
-        )
+        let [a, b, c, d, e] = z.map(compact);
+        write!(f, "(s_x {a}, s_a {b}, s_y {c}, II00 {d}, II11 {e})")
     }
 }
 
@@ -52,7 +72,8 @@ impl MacroStrain {
         MacroStrain([s_x, s_a, s_y, 0.0, 0.0])
     }
 
-    /// Check the strain: finite, 1 + s_x > 0, 1 + s_y > 0, |s_a| < 1, and at most one bending non-zero.
+    /// Check the strain: finite, 1 + s_x and 1 + s_y in [[`MIN_STRETCH`], [`MAX_STRETCH`]], |s_a| < 1,
+    /// |Π₀₀|, |Π₁₁| ≤ [`MAX_CURVATURE`], and at most one bending non-zero (`03-homogenization.md`, section 1).
     pub fn validate(&self) -> Result<Family, StrainError> {
         let z = self.0;
         let err = |m: String| {
@@ -64,17 +85,31 @@ impl MacroStrain {
         if let Some(k) = z.iter().position(|v| !v.is_finite()) {
             return err(format!("{} is not finite", StrainComponent::NAMES[k]));
         }
-        if 1.0 + z[0] <= 0.0 {
-            return err(format!("1 + s_x = {} must be positive", 1.0 + z[0]));
-        }
-        if 1.0 + z[2] <= 0.0 {
-            return err(format!("1 + s_y = {} must be positive", 1.0 + z[2]));
+        for k in [0, 2] {
+            let stretch = 1.0 + z[k];
+            if !(MIN_STRETCH..=MAX_STRETCH).contains(&stretch) {
+                return err(format!(
+                    "{} = {}: the stretch 1 + {0} = {} must lie in [{MIN_STRETCH}, {MAX_STRETCH}]",
+                    StrainComponent::NAMES[k],
+                    compact(z[k]),
+                    compact(stretch)
+                ));
+            }
         }
         if z[1].abs() >= 1.0 {
             return err(format!(
                 "|s_a| = {} must be below 1 (s_a is the cosine of the angle between the material axes)",
                 z[1].abs()
             ));
+        }
+        for k in [3, 4] {
+            if z[k].abs() > MAX_CURVATURE {
+                return err(format!(
+                    "{} = {} 1/m: |{0}| must be at most {MAX_CURVATURE:e} 1/m",
+                    StrainComponent::NAMES[k],
+                    compact(z[k])
+                ));
+            }
         }
         if z[3] != 0.0 && z[4] != 0.0 {
             return err(
@@ -86,6 +121,27 @@ impl MacroStrain {
         } else {
             Family::BendY
         })
+    }
+
+    /// [`MacroStrain::validate`], then the pattern's curvature bound |Π| r ≤ [`MAX_CURVATURE_RADIUS`] for a yarn
+    /// radius `radius` (m).
+    pub fn validate_for_radius(&self, radius: f64) -> Result<Family, StrainError> {
+        let family = self.validate()?;
+        for k in [3, 4] {
+            let kr = self.0[k].abs() * radius;
+            if kr > MAX_CURVATURE_RADIUS {
+                return Err(StrainError {
+                    strain: *self,
+                    message: format!(
+                        "{} = {} 1/m: |{0}| r = {kr} must be at most {MAX_CURVATURE_RADIUS} for the yarn radius \
+                         r = {radius} m (a bending radius below the yarn radius)",
+                        StrainComponent::NAMES[k],
+                        self.0[k]
+                    ),
+                });
+            }
+        }
+        Ok(family)
     }
 
     /// The first fundamental form Ī = [[a², abc], [abc, b²]] (a = 1 + s_x, b = 1 + s_y, c = s_a).
@@ -128,6 +184,61 @@ mod tests {
         ] {
             let e = bad.validate().unwrap_err();
             assert!(!e.message.is_empty(), "{e}");
+        }
+    }
+
+    #[test]
+    fn absurd_strains_are_rejected_naming_the_component() {
+        for (bad, name) in [
+            (MacroStrain::new(1e6, 0.0, 0.0, 0.0, 0.0), "s_x"),
+            (MacroStrain::new(1e300, 0.0, 0.0, 0.0, 0.0), "s_x"),
+            (MacroStrain::new(0.0, 0.0, 9.5, 0.0, 0.0), "s_y"),
+            (MacroStrain::new(0.0, 0.0, -0.95, 0.0, 0.0), "s_y"),
+            (
+                MacroStrain::new(0.0, 0.0, 0.0, 1e12, 0.0),
+                StrainComponent::NAMES[3],
+            ),
+            (
+                MacroStrain::new(0.0, 0.0, 0.0, 0.0, -2e6),
+                StrainComponent::NAMES[4],
+            ),
+        ] {
+            let e = bad.validate().unwrap_err();
+            assert!(e.message.starts_with(name), "{e}");
+        }
+        assert!(MacroStrain::new(9.0, 0.0, -0.89, 0.0, 0.0)
+            .validate()
+            .is_ok());
+        let bent = MacroStrain::new(0.0, 0.0, 0.0, 900.0, 0.0);
+        assert!(bent.validate_for_radius(1e-3).is_ok());
+        let e = bent.validate_for_radius(2e-3).unwrap_err();
+        assert!(e.message.contains("yarn radius"), "{e}");
+    }
+
+    #[test]
+    fn every_built_in_and_validation_plan_is_admissible() {
+        use crate::sample::Plan;
+        let mut plans = vec![
+            ("default".to_string(), Plan::default()),
+            ("reduced".into(), Plan::reduced()),
+            ("quick".into(), Plan::quick()),
+            ("holdout".into(), Plan::holdout()),
+        ];
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/validation/plans");
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            let text = std::fs::read_to_string(&path).unwrap();
+            let plan = Plan::from_json(&text, Some(&path.display().to_string())).unwrap();
+            plans.push((path.display().to_string(), plan));
+        }
+        assert!(plans.len() >= 14);
+        for (name, plan) in &plans {
+            for s in plan.samples() {
+                // the original patterns' radius, about 1 mm
+                if let Err(e) = MacroStrain(s.z).validate_for_radius(1.001e-3) {
+                    panic!("{name}: {e}");
+                }
+            }
         }
     }
 

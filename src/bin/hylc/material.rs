@@ -63,8 +63,15 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     if strains.is_empty() && a.write.is_none() {
         anyhow::bail!("no strains given: use --z SX,SA,SY,II00,II01,II11 or --z-file FILE");
     }
-    for z in &strains {
-        let r = mat.eval(z);
+    // every strain is checked before anything is printed: an out-of-range strain is bad input (exit 2)
+    let mut results = Vec::with_capacity(strains.len());
+    for (i, z) in strains.iter().enumerate() {
+        results.push(
+            mat.eval_checked(z)
+                .map_err(|e| anyhow!("strain #{}: {e}", i + 1))?,
+        );
+    }
+    for (z, r) in strains.iter().zip(results) {
         if a.json {
             println!("{}", psi_json(z, &r));
         } else {

@@ -15,6 +15,25 @@ pub const DIRECTOR_PERP_TOL: f64 = 2e-3;
 /// check warns (basket: 6.6 %; the other originals: < 0.002 %).
 pub const PERIOD_MISMATCH_TOL: f64 = 0.01;
 
+/// Smallest plausible yarn radius r (m): 1 µm, the radius of a fine single filament (the originals: 1 mm).
+pub const MIN_RADIUS: f64 = 1e-6;
+/// Largest plausible yarn radius r (m): 5 cm, thicker than any rope used as yarn. It also catches a file written
+/// in millimetres (r = 1 for a 1 mm yarn) and keeps the micro solver's lengths far from overflow.
+pub const MAX_RADIUS: f64 = 0.05;
+/// Smallest period p₁, p₂ relative to the radius: a tile narrower than one yarn radius would overlap every yarn
+/// with its own periodic images (the originals: 7.9 r and more).
+pub const MIN_PERIOD_RATIO: f64 = 1.0;
+/// Largest period p₁, p₂ relative to the radius (the originals: at most 17.4 r). The micro solver's start phase
+/// moves curvature in steps proportional to r / p, so this bounds its work too.
+pub const MAX_PERIOD_RATIO: f64 = 1e4;
+/// Smallest rest length l̄ relative to the radius: the stretch energy grows like 1/l̄ and overflows for
+/// sub-normal lengths (5e-324 gave Ψ̄ = inf). The originals' edges are 0.53 r and longer and the generator samples
+/// at most 100 vertices per radius (l̄ ≥ 0.01 r), so 1e-3 r leaves a margin of 10×.
+pub const MIN_REST_LENGTH_RATIO: f64 = 1e-3;
+/// Largest rest length l̄ relative to the radius (the originals: at most 1.5 r): an edge may not be longer than
+/// the largest admissible period, [`MAX_PERIOD_RATIO`] r.
+pub const MAX_REST_LENGTH_RATIO: f64 = MAX_PERIOD_RATIO;
+
 /// A consistency problem that does not stop a pattern from loading.
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
@@ -200,6 +219,30 @@ impl Checker<'_> {
                 return Err(self.at(p, 0, format!("{name} = {v} must be positive")));
             }
         }
+        let r = self.p.radius;
+        if !(MIN_RADIUS..=MAX_RADIUS).contains(&r) {
+            return Err(self.at(
+                p,
+                0,
+                format!(
+                    "r = {r:e} m is not a plausible yarn radius (must lie in [{MIN_RADIUS:e}, {MAX_RADIUS}] m; lengths \
+                     are in metres)"
+                ),
+            ));
+        }
+        for (name, v) in [("px", self.p.periods[0]), ("py", self.p.periods[1])] {
+            let ratio = v / r;
+            if !(MIN_PERIOD_RATIO..=MAX_PERIOD_RATIO).contains(&ratio) {
+                return Err(self.at(
+                    p,
+                    0,
+                    format!(
+                        "{name} = {v:e} m is {ratio:.3e} yarn radii (must lie in [{MIN_PERIOD_RATIO}, \
+                         {MAX_PERIOD_RATIO:e}] r)"
+                    ),
+                ));
+            }
+        }
         Ok(())
     }
 
@@ -285,6 +328,18 @@ impl Checker<'_> {
                     Block::RL,
                     i,
                     format!("rest length {} of edge {i} must be positive", e.rest_length),
+                ));
+            }
+            let ratio = e.rest_length / p.radius;
+            if !(MIN_REST_LENGTH_RATIO..=MAX_REST_LENGTH_RATIO).contains(&ratio) {
+                return Err(self.at(
+                    Block::RL,
+                    i,
+                    format!(
+                        "rest length {:e} m of edge {i} is {ratio:.3e} yarn radii (must lie in \
+                         [{MIN_REST_LENGTH_RATIO:e}, {MAX_REST_LENGTH_RATIO:e}] r)",
+                        e.rest_length
+                    ),
                 ));
             }
         }

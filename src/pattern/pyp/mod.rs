@@ -27,7 +27,10 @@
 //! [`Pattern::to_pyp_string`] would write. [`Pattern::validate_as`] checks:
 //!
 //! - sizes: n ≥ 1 and every per-vertex array has n entries, `edge_file_order` is a permutation of 0..n;
-//! - every number finite; periods, radius and rest lengths positive;
+//! - every number finite; periods, radius and rest lengths positive; the radius plausible, in [[`MIN_RADIUS`],
+//!   [`MAX_RADIUS`]] = [1 µm, 5 cm]; the periods in [[`MIN_PERIOD_RATIO`], [`MAX_PERIOD_RATIO`]] = [1, 1e4] radii;
+//!   the rest lengths in [[`MIN_REST_LENGTH_RATIO`], [`MAX_REST_LENGTH_RATIO`]] = [1e-3, 1e4] radii (the
+//!   originals: r ≈ 1 mm, periods 7.9–17.4 r, rest lengths 0.53–1.5 r);
 //! - edges: end vertex in 0..n, offsets in {−1, 0, 1}, exactly one incoming edge per vertex (one outgoing edge per
 //!   vertex is a parse check: a file may list two edges from one vertex), non-zero current length;
 //! - reference directors: unit, |‖u‖ − 1| ≤ [`DIRECTOR_NORM_TOL`] = 1e-5, and perpendicular to their edge,
@@ -48,7 +51,9 @@ mod read;
 mod write;
 
 pub use checks::{
-    PatternWarning, PeriodMismatch, DIRECTOR_NORM_TOL, DIRECTOR_PERP_TOL, PERIOD_MISMATCH_TOL,
+    PatternWarning, PeriodMismatch, DIRECTOR_NORM_TOL, DIRECTOR_PERP_TOL, MAX_PERIOD_RATIO,
+    MAX_RADIUS, MAX_REST_LENGTH_RATIO, MIN_PERIOD_RATIO, MIN_RADIUS, MIN_REST_LENGTH_RATIO,
+    PERIOD_MISMATCH_TOL,
 };
 
 use super::Pattern;
