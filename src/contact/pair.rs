@@ -88,6 +88,18 @@ pub struct PairKernel {
     rule: GaussLegendre,
 }
 
+/// Rest lengths enter E_ab as the factor l̄_a l̄_b: both must be finite and ≥ 0.
+#[inline]
+fn check_rest(rest_a: f64, rest_b: f64) -> Result<(), ContactError> {
+    if rest_a.is_finite() && rest_b.is_finite() && rest_a >= 0.0 && rest_b >= 0.0 {
+        Ok(())
+    } else {
+        Err(ContactError::InvalidParameter(format!(
+            "rest lengths {rest_a}, {rest_b} must be finite and ≥ 0"
+        )))
+    }
+}
+
 impl PairKernel {
     /// A kernel with stiffness k_c > 0, radius r > 0 (both finite) and quadrature order Q ≥ 1.
     pub fn new(stiffness: f64, radius: f64, order: usize) -> Result<Self, ContactError> {
@@ -146,6 +158,7 @@ impl PairKernel {
         rest_a: f64,
         rest_b: f64,
     ) -> Result<f64, ContactError> {
+        check_rest(rest_a, rest_b)?;
         if self.beyond_cutoff(x) {
             return Ok(0.0);
         }
@@ -178,6 +191,7 @@ impl PairKernel {
         rest_a: f64,
         rest_b: f64,
     ) -> Result<f64, ContactError> {
+        check_rest(rest_a, rest_b)?;
         if self.beyond_cutoff(x) {
             return Ok(0.0);
         }
@@ -206,6 +220,7 @@ impl PairKernel {
         rest_a: f64,
         rest_b: f64,
     ) -> Result<PairVgh, ContactError> {
+        check_rest(rest_a, rest_b)?;
         if self.beyond_cutoff(x) {
             return Ok(PairVgh::zero());
         }

@@ -54,8 +54,12 @@ pub const MAX_PLAN_SAMPLES: usize = 1_000_000;
 /// The largest stretch s_x, s_y a plan may sample (a stretch ratio of 4). The built-in plans reach 0.96, the
 /// in-plane grid 1.0 and the plans under `validation/plans/` 0.99; beyond a ratio of about 2 a yarn-level pattern
 /// has straightened its yarns and only stretches the yarns themselves (orders of magnitude stiffer), so larger
-/// values only make the solves long or fail. The lower limit of a stretch is −1 (exclusive): zero length.
+/// values only make the solves long or fail. The lower limit is [`MIN_PLAN_STRETCH`].
 pub const MAX_PLAN_STRETCH: f64 = 3.0;
+
+/// The smallest s_x, s_y a plan may sample (up to rounding: the test is 1 + s ≥ the micro solver's smallest
+/// stretch [`crate::micro::strain::MIN_STRETCH`]), so that every strain a plan passes is one the solver accepts.
+pub const MIN_PLAN_STRETCH: f64 = crate::micro::strain::MIN_STRETCH - 1.0;
 
 /// |s_a| must stay below this (exclusive): s_a is the cosine of the angle between the deformed warp and weft
 /// directions, so |s_a| = 1 folds them onto one line. The built-in plans reach 0.7, `validation/plans/` 0.75.
@@ -66,15 +70,17 @@ pub const MAX_PLAN_SHEAR: f64 = 1.0;
 pub const MAX_PLAN_CURVATURE: f64 = 1000.0;
 
 /// Why value `v` of strain `k` (0..5: s_x, s_a, s_y, Π₀₀, Π₁₁) is not admissible in a plan, if it is not: finite,
-/// stretches in (−1, [`MAX_PLAN_STRETCH`]], |s_a| < [`MAX_PLAN_SHEAR`], |Π| ≤ [`MAX_PLAN_CURVATURE`].
+/// stretches in [[`MIN_PLAN_STRETCH`], [`MAX_PLAN_STRETCH`]], |s_a| < [`MAX_PLAN_SHEAR`], |Π| ≤
+/// [`MAX_PLAN_CURVATURE`].
 pub fn inadmissible(k: usize, v: f64) -> Option<String> {
     let name = StrainComponent::NAMES[k];
     if !v.is_finite() {
         return Some(format!("{name} = {v} is not finite"));
     }
     match k {
-        0 | 2 if v <= -1.0 || v > MAX_PLAN_STRETCH => Some(format!(
-            "{name} = {v} is outside the admissible stretches (−1, {MAX_PLAN_STRETCH}]"
+        // the solver's own test on 1 + s, so that a plan never passes a strain the solver refuses
+        0 | 2 if !(1.0 + v >= crate::micro::strain::MIN_STRETCH && v <= MAX_PLAN_STRETCH) => Some(format!(
+            "{name} = {v} is outside the admissible stretches [{MIN_PLAN_STRETCH}, {MAX_PLAN_STRETCH}]"
         )),
         1 if v.abs() >= MAX_PLAN_SHEAR => Some(format!(
             "{name} = {v} is outside the admissible shears (−{MAX_PLAN_SHEAR}, {MAX_PLAN_SHEAR})"
@@ -504,7 +510,7 @@ impl Plan {
     }
 
     /// Check ranges, counts and pairs: every range value and grid value admissible ([`inadmissible`]: stretches in
-    /// (−1, [`MAX_PLAN_STRETCH`]], |s_a| < [`MAX_PLAN_SHEAR`], |Π| ≤ [`MAX_PLAN_CURVATURE`]), every count and the
+    /// [[`MIN_PLAN_STRETCH`], [`MAX_PLAN_STRETCH`]], |s_a| < [`MAX_PLAN_SHEAR`], |Π| ≤ [`MAX_PLAN_CURVATURE`]), every count and the
     /// total at most [`MAX_PLAN_SAMPLES`] (`04-sampling-fitting.md`, "Sampling plan (C4)"). Every runner and
     /// [`Plan::from_json`] call this before enumerating a sample.
     pub fn validate(&self) -> Result<(), PlanError> {
@@ -853,6 +859,29 @@ impl Plan {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn plan_stretch_limits_agree_with_the_solver() {
+        // up to the plan's own upper limit, a plan accepts exactly the stretches the micro solver accepts
+        for v in [
+            -1.0,
+            -0.95,
+            -0.9,
+            MIN_PLAN_STRETCH,
+            -0.899_999_999,
+            -0.85,
+            0.0,
+            2.5,
+            3.0,
+        ] {
+            let plan = inadmissible(0, v).is_none();
+            let solver = crate::micro::MacroStrain::in_plane(v, 0.0, 0.0)
+                .validate()
+                .is_ok();
+            assert_eq!(plan, solver, "s_x = {v}");
+        }
+        assert!(inadmissible(2, 3.01).is_some());
+    }
 
     #[test]
     fn holdout_grid_samples_and_chains() {
@@ -1208,7 +1237,7 @@ mod tests {
         assert_eq!(p.validate().unwrap_err().field, "ranges_2d[5][1]");
         // the limits themselves are admissible; every built-in plan is valid
         p.ranges_2d = None;
-        p.ranges.s_x = [-0.99, MAX_PLAN_STRETCH];
+        p.ranges.s_x = [-0.85, MAX_PLAN_STRETCH];
         p.ranges.ii00 = [-MAX_PLAN_CURVATURE, MAX_PLAN_CURVATURE];
         p.ranges.s_a = [-0.999, 0.999];
         p.validate().unwrap();

@@ -29,6 +29,16 @@ type M3 = Matrix3<f64>;
 /// Number of stencil dofs.
 pub const NDOF: usize = 18;
 
+/// The largest |coordinate| (m) of a stencil the strain chain accepts: the scenes' own bound on positions
+/// (`scene::MAX_COORDINATE`); beyond it the products of the Hessian overflow. A stencil outside is treated as
+/// degenerate (`None`).
+pub const MAX_POSITION: f64 = 1e6;
+
+/// Every coordinate finite and within ±[`MAX_POSITION`].
+fn admissible_positions(q: &[f64; NDOF]) -> bool {
+    q.iter().all(|v| v.abs() <= MAX_POSITION)
+}
+
 /// Rest (material) data of a triangle: D_m⁻¹ (row-major), rest area, and the edge vectors r_i of the bending sum.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RestTriangle {
@@ -162,6 +172,9 @@ fn in_plane(q: &[f64; NDOF], rest: &RestTriangle) -> Option<([V3; 2], [f64; 2])>
 /// z(q) only (the fast value path). `None` when the deformed triangle or a hinge is degenerate (zero-length
 /// edge, zero area, non-finite input).
 pub fn strain(q: &[f64; NDOF], rest: &RestTriangle, flaps: [bool; 3]) -> Option<[f64; 6]> {
+    if !admissible_positions(q) {
+        return None;
+    }
     let (f, n) = in_plane(q, rest)?;
     let mut z = [
         n[0] - 1.0,
@@ -200,6 +213,9 @@ impl StrainChain {
     /// z and its Jacobian. `None` on a degenerate configuration (see [`strain`]); a flap whose vertex lies on the
     /// edge line contributes θ = 0 (its derivatives are then undefined, and it is reported as degenerate too).
     pub fn new(q: &[f64; NDOF], rest: &RestTriangle, flaps: [bool; 3]) -> Option<Self> {
+        if !admissible_positions(q) {
+            return None;
+        }
         let (f, n) = in_plane(q, rest)?;
         let beta = rest.beta();
         let u = [f[0] / n[0], f[1] / n[1]];

@@ -107,7 +107,8 @@ pub const EXTREME_NUMBERS: [&str; 14] = [
 
 /// Apply `m` to `text` (bytes: the result need not be UTF-8).
 pub fn mutate(text: &[u8], m: Mutation, rng: &mut ChaCha8Rng) -> Vec<u8> {
-    let lines = |t: &[u8]| -> Vec<Vec<u8>> { t.split(|&b| b == b'\n').map(<[u8]>::to_vec).collect() };
+    let lines =
+        |t: &[u8]| -> Vec<Vec<u8>> { t.split(|&b| b == b'\n').map(<[u8]>::to_vec).collect() };
     match m {
         Mutation::Truncate => text[..rng.random_range(0..=text.len())].to_vec(),
         Mutation::DeleteLine | Mutation::DuplicateLine => {
@@ -478,7 +479,10 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let t = b"a 1.5\nb 2\nc -3e4\n";
         assert!(mutate(t, Mutation::ByteOrderMark, &mut rng).starts_with(&[0xEF, 0xBB, 0xBF]));
-        assert_eq!(mutate(t, Mutation::Crlf, &mut rng), b"a 1.5\r\nb 2\r\nc -3e4\r\n");
+        assert_eq!(
+            mutate(t, Mutation::Crlf, &mut rng),
+            b"a 1.5\r\nb 2\r\nc -3e4\r\n"
+        );
         let r = mutate(t, Mutation::ReplaceNumber, &mut rng);
         let s = String::from_utf8(r).unwrap();
         assert!(EXTREME_NUMBERS.iter().any(|n| s.contains(n)), "{s}");

@@ -14,7 +14,12 @@ use std::time::Instant;
 #[derive(clap::Args)]
 pub struct Args {
     /// the formats (comma-separated)
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "pyp,material,plan,scene,samples")]
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "pyp,material,plan,scene,samples"
+    )]
     format: Vec<FormatArg>,
     /// cases per format
     #[arg(long, default_value_t = 10_000)]
@@ -59,7 +64,9 @@ pub fn run_cmd(a: Args) -> anyhow::Result<ExitCode> {
         let format = Format::from(*f);
         let bar = ProgressBar::new(a.cases as u64);
         let t = Instant::now();
-        let r = run(format, a.cases, a.seed, &dir, &mut |n| bar.set_position(n as u64));
+        let r = run(format, a.cases, a.seed, &dir, &mut |n| {
+            bar.set_position(n as u64)
+        });
         bar.finish_and_clear();
         println!(
             "| {} | {} | {} | {} | {} | {} | {} | {:.2} s | {:.0} s |",
