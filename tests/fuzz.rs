@@ -21,17 +21,7 @@ fn check(format: Format) {
     std::fs::create_dir_all(&dir).unwrap();
     let r: FuzzReport = run(format, cases(), 1, &dir, &mut |_| {});
     std::fs::remove_dir_all(&dir).ok();
-    eprintln!(
-        "{}: {} cases, {} accepted, {} rejected, {} non-finite, {} panics, {} slow, longest {:.2} s",
-        format.name(),
-        r.cases,
-        r.accepted,
-        r.rejected,
-        r.non_finite,
-        r.panics,
-        r.slow,
-        r.longest.as_secs_f64()
-    );
+    eprintln!("{}: {}", format.name(), r.counts());
     assert_eq!(r.failed(), 0, "{}: {:#?}", format.name(), r.failures);
     // the mutators must leave some inputs valid, or the evaluators are never reached
     assert!(r.accepted > 0, "{}: no case was accepted", format.name());

@@ -207,6 +207,20 @@ pub struct FuzzReport {
 }
 
 impl FuzzReport {
+    /// The counts as one line: cases, accepted, rejected, non-finite, panics, slow, longest case.
+    pub fn counts(&self) -> String {
+        format!(
+            "{} cases, {} accepted, {} rejected, {} non-finite, {} panics, {} slow, longest {:.2} s",
+            self.cases,
+            self.accepted,
+            self.rejected,
+            self.non_finite,
+            self.panics,
+            self.slow,
+            self.longest.as_secs_f64()
+        )
+    }
+
     /// Panics, non-finite outputs and slow cases: the targets are zero.
     pub fn failed(&self) -> usize {
         self.non_finite + self.panics + self.slow

@@ -55,10 +55,11 @@ pub fn run_cmd(a: Args) -> anyhow::Result<ExitCode> {
     std::fs::create_dir_all(&dir)
         .map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
     println!(
-        "| format | cases | accepted | rejected (typed error) | non-finite | panics | slow (> {} s) | longest | time |",
+        "cases per format {}, seed {}; rejected = a typed error; slow = over {} s",
+        a.cases,
+        a.seed,
         CASE_BUDGET.as_secs()
     );
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     let mut failed = 0;
     for f in &a.format {
         let format = Format::from(*f);
@@ -69,15 +70,9 @@ pub fn run_cmd(a: Args) -> anyhow::Result<ExitCode> {
         });
         bar.finish_and_clear();
         println!(
-            "| {} | {} | {} | {} | {} | {} | {} | {:.2} s | {:.0} s |",
+            "{}: {} ({:.0} s)",
             format.name(),
-            r.cases,
-            r.accepted,
-            r.rejected,
-            r.non_finite,
-            r.panics,
-            r.slow,
-            r.longest.as_secs_f64(),
+            r.counts(),
             t.elapsed().as_secs_f64()
         );
         for (case, muts, what) in &r.failures {
