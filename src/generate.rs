@@ -17,6 +17,7 @@
 //! Vertex order: yarn by yarn, each yarn's vertices contiguous in the order its edges visit them; `edge_file_order`
 //! is `0..n`.
 
+use crate::pattern::pyp::{MAX_RADIUS, MIN_RADIUS};
 use crate::pattern::{Edge, Pattern};
 use crate::rod::frame::transport;
 use crate::rod::state::{raw_reference_twists, set_rest_to_current};
@@ -36,6 +37,19 @@ fn bad<T>(parameter: &str, message: impl Into<String>) -> Result<T, GenerateErro
         parameter: parameter.into(),
         message: message.into(),
     })
+}
+
+/// The yarn radius within the range a `.pyp` file may have ([`MIN_RADIUS`], [`MAX_RADIUS`] m), so that every
+/// generated pattern also loads back.
+fn plausible_radius(r: f64) -> Result<(), GenerateError> {
+    if (MIN_RADIUS..=MAX_RADIUS).contains(&r) {
+        Ok(())
+    } else {
+        bad(
+            "radius",
+            format!("{r} m is outside the plausible yarn radii [{MIN_RADIUS}, {MAX_RADIUS}] m"),
+        )
+    }
 }
 
 fn positive(name: &str, v: f64) -> Result<(), GenerateError> {
@@ -161,6 +175,7 @@ impl WeaveParams {
 
     fn validate(&self) -> Result<(usize, usize), GenerateError> {
         positive("radius", self.radius)?;
+        plausible_radius(self.radius)?;
         positive("spacing", self.spacing)?;
         positive("crimp", self.crimp)?;
         positive("vertices_per_radius", self.vertices_per_radius)?;
@@ -396,6 +411,7 @@ impl KnitParams {
 
     fn validate(&self) -> Result<(), GenerateError> {
         positive("radius", self.radius)?;
+        plausible_radius(self.radius)?;
         positive("wale_spacing", self.wale_spacing)?;
         positive("course_spacing", self.course_spacing)?;
         positive("loop_height", self.loop_height)?;

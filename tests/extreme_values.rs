@@ -1,9 +1,11 @@
-//! Extreme-value properties (issue 17): 10⁴ random extreme inputs each for ψ, the shell strain chain and the
-//! contact pair kernel give finite outputs or an explicit rejection (a typed error, or `None` for a degenerate
+//! Extreme-value properties (issue 17): 10⁴ random extreme inputs each for ψ, the shell strain chain, the rod
+//! stencils (their checked entry points) and the contact pair kernel give finite outputs or an explicit rejection (a typed error, or `None` for a degenerate
 //! triangle) — never NaN or inf. Inputs mix magnitudes from 1e-300 to 1e300 of either sign with zeros, NaN and ±inf.
 
 use hylc::contact::pair::PairKernel;
 use hylc::material::synthetic::default_material;
+use hylc::rod::checked::{bend_twist_checked, stretch_checked};
+use hylc::rod::{BendTwistParams, StencilFrames};
 use hylc::shell::{RestTriangle, StrainChain};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
@@ -132,6 +134,62 @@ fn contact_pair_is_finite_or_an_error_at_extreme_positions() {
                 assert!(
                     all_finite(values),
                     "non-finite contact energy at x = {x:?}, rest {rest:?}"
+                );
+                ok += 1;
+            }
+            Err(_) => errors += 1,
+        }
+    }
+    assert!(ok > CASES / 10, "{ok} evaluated, {errors} errors");
+}
+
+#[test]
+fn rod_stencils_are_finite_or_an_error_at_extreme_inputs() {
+    let r = 1e-3;
+    let mut rng = ChaCha8Rng::seed_from_u64(20);
+    let (mut ok, mut errors) = (0, 0);
+    for _ in 0..CASES {
+        // a bent stencil of three vertices 1 mm apart, perturbed by extremes
+        let mut x = [
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(r, 0.0, 0.0),
+            Vector3::new(2.0 * r, 0.3 * r, 0.0),
+        ];
+        let n = rng.random_range(1..4);
+        for _ in 0..n {
+            let (i, c) = (rng.random_range(0..3), rng.random_range(0..3));
+            x[i][c] += extreme(&mut rng, r);
+        }
+        let rest = extreme(&mut rng, r).abs();
+        match stretch_checked(&x[0], &x[1], rest, extreme(&mut rng, 1e3)) {
+            Ok((e, g, h)) => {
+                let values = std::iter::once(e)
+                    .chain(g.iter().copied())
+                    .chain(h.iter().copied());
+                assert!(all_finite(values), "stretch at x = {x:?}, rest {rest}");
+                ok += 1;
+            }
+            Err(_) => errors += 1,
+        }
+        let t0 = Vector3::new(1.0, 0.0, 0.0);
+        let t1 = Vector3::new(0.96, 0.28, 0.0);
+        let fr = StencilFrames::new(t0, Vector3::z(), t1, Vector3::z(), extreme(&mut rng, 0.1));
+        let p = BendTwistParams {
+            rest_curvature: [extreme(&mut rng, 0.5), extreme(&mut rng, 0.5)],
+            rest_twist: extreme(&mut rng, 0.1),
+            voronoi_length: extreme(&mut rng, r).abs(),
+            bend: extreme(&mut rng, 1e-6).abs(),
+            twist: extreme(&mut rng, 1e-6).abs(),
+        };
+        let theta = [extreme(&mut rng, 1.0), extreme(&mut rng, 1.0)];
+        match bend_twist_checked(&x, theta, &fr, &p) {
+            Ok((e, g, h)) => {
+                let values = std::iter::once(e)
+                    .chain(g.iter().copied())
+                    .chain(h.iter().copied());
+                assert!(
+                    all_finite(values),
+                    "bend-twist at x = {x:?}, θ {theta:?}, {p:?}"
                 );
                 ok += 1;
             }

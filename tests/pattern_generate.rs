@@ -373,6 +373,22 @@ fn bad_parameters_are_reported() {
         ),
         (
             err_weave(WeaveParams {
+                radius: 1e11,
+                ..plain()
+            }),
+            "radius",
+            "plausible yarn radii",
+        ),
+        (
+            err_knit(KnitParams {
+                radius: 1e-9,
+                ..KnitParams::stockinette()
+            }),
+            "radius",
+            "plausible yarn radii",
+        ),
+        (
+            err_weave(WeaveParams {
                 spacing: 1.5e-3,
                 crimp: 1e-3,
                 ..plain()

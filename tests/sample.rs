@@ -178,6 +178,19 @@ fn merged_shards_equal_the_unsharded_run() {
         .map(|r| r.index)
         .collect();
     assert!(idx.windows(2).all(|w| w[0] < w[1]));
+    // a shard whose record has another result for the same id is refused, naming the id
+    let text = std::fs::read_to_string(&files[0]).unwrap();
+    let mut first: Record = serde_json::from_str(text.lines().next().unwrap()).unwrap();
+    first.psi = first.psi.map(|p| p * 2.0 + 1.0);
+    let conflict = d.join("conflict.jsonl");
+    std::fs::write(&conflict, serde_json::to_string(&first).unwrap() + "\n").unwrap();
+    let e = merge(
+        &d.join("m2.jsonl"),
+        &[files[0].as_path(), conflict.as_path()],
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("conflict.jsonl") && e.contains(&first.id), "{e}");
     std::fs::remove_dir_all(&d).ok();
 }
 

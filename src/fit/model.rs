@@ -247,11 +247,7 @@ pub fn check_records(records: &[Record]) -> Result<(), FitError> {
             ));
         }
         if let Some(first) = seen.insert(r.id.as_str(), r) {
-            let same = first.z == r.z
-                && first.status == r.status
-                && first.psi.map(f64::to_bits) == r.psi.map(f64::to_bits)
-                && first.stress == r.stress;
-            if !same {
+            if !first.same_result(r) {
                 return Err(bad(
                     r,
                     "id",

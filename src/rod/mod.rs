@@ -2,6 +2,7 @@
 //! 2010): frames, parallel transport, reference twist, and the stretching and bending+twisting stencils.
 
 pub mod bend_twist;
+pub mod checked;
 pub mod frame;
 pub mod generic;
 pub mod jet;

@@ -21,7 +21,7 @@ use crate::micro::envelope::strain_derivatives;
 use crate::micro::{MacroStrain, MicroProblem, MicroState, Status};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::Path;
@@ -61,6 +61,15 @@ pub struct Record {
 }
 
 impl Record {
+    /// The same solve result as `other` (strain, status, Ψ̄ bitwise, stress): a repeated id with another result
+    /// is a conflict that `merge` and `fit` refuse.
+    pub fn same_result(&self, other: &Record) -> bool {
+        self.z == other.z
+            && self.status == other.status
+            && self.psi.map(f64::to_bits) == other.psi.map(f64::to_bits)
+            && self.stress == other.stress
+    }
+
     /// Ψ̄ when the sample counts as converged: status `Converged` and a finite Ψ̄. A `Stalled`, `MaxSteps` or
     /// `TimeLimit` record may carry the Ψ̄ of its last iterate, which is not an equilibrium, so it is no sample.
     pub fn converged_psi(&self) -> Option<f64> {
@@ -478,18 +487,30 @@ impl PlanRun<'_> {
     }
 }
 
-/// Merge sample files (e.g. shards) into `out`: all records, the first of each id kept, ordered by plan index then
-/// id. Returns (records written, duplicates dropped). `out` is written to a temporary file and renamed.
+/// Merge sample files (e.g. shards) into `out`: all records, ordered by plan index then id; a repeated id with the
+/// same result ([`Record::same_result`]) is dropped, with another result it is an error naming the file and id.
+/// Returns (records written, duplicates dropped). `out` is written to a temporary file and renamed.
 pub fn merge(out: &Path, inputs: &[&Path]) -> Result<(usize, usize), SampleError> {
-    let mut seen = HashSet::new();
-    let mut records = Vec::new();
+    let mut seen: HashMap<String, usize> = HashMap::new();
+    let mut records: Vec<Record> = Vec::new();
     let mut duplicates = 0;
     for path in inputs {
         for r in read_samples(path, false)? {
-            if seen.insert(r.id.clone()) {
-                records.push(r);
-            } else {
-                duplicates += 1;
+            match seen.get(&r.id) {
+                None => {
+                    seen.insert(r.id.clone(), records.len());
+                    records.push(r);
+                }
+                Some(&k) if records[k].same_result(&r) => duplicates += 1,
+                Some(&k) => {
+                    return Err(SampleError::File {
+                        path: path.to_path_buf(),
+                        message: format!(
+                            "sample {} has another result than in an earlier input (Ψ̄ {:?} and {:?}, status {:?} and {:?})",
+                            r.id, records[k].psi, r.psi, records[k].status, r.status
+                        ),
+                    })
+                }
             }
         }
     }
