@@ -86,6 +86,33 @@ impl Pattern {
         self.lower.nnz()
     }
 
+    /// Add the symmetric 18×18 matrix `h` of stencil number `si` (stencil `s`) to the free-dof values.
+    pub fn add_stencil_hessian(
+        &self,
+        values: &mut [f64],
+        si: usize,
+        s: &Stencil,
+        h: &[[f64; NDOF]; NDOF],
+    ) {
+        let offs = &self.offs[si];
+        for a in 0..6 {
+            for b in 0..6 {
+                let base = 18 * a + 3 * b;
+                if offs[base] == NONE {
+                    continue;
+                }
+                let diag = self.free[s.v[a]] == self.free[s.v[b]];
+                for c in 0..3 {
+                    let start = offs[base + c] as usize;
+                    let r0 = if diag { c } else { 0 };
+                    for r in r0..3 {
+                        values[start + r - r0] += h[3 * a + r][3 * b + c];
+                    }
+                }
+            }
+        }
+    }
+
     /// Add a symmetric 3×3 block to the diagonal block of free vertex `k`.
     pub fn add_diag_block(&self, values: &mut [f64], k: usize, m: &[[f64; 3]; 3]) {
         for c in 0..3 {

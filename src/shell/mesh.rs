@@ -136,6 +136,25 @@ impl Mesh {
 
     /// Parse OBJ text; `name` is used in error messages.
     pub fn parse_obj(text: &str, name: &str) -> Result<(Mesh, Vec<[f64; 3]>), ShellError> {
+        let (pos, tris, origin, vline) = parse_obj_surface(text, name)?;
+        Self::flat(pos, tris, origin, &vline, name)
+    }
+}
+
+/// An OBJ surface: positions, fan-triangulated faces, each face's `file:line`, each vertex's line.
+type ObjSurface = (Vec<[f64; 3]>, Vec<[usize; 3]>, Vec<String>, Vec<usize>);
+
+/// Read any OBJ triangle surface (`v` and `f` lines; polygons fan-triangulated) for an obstacle; errors name
+/// the file and line.
+pub fn load_obj_surface(path: &Path) -> Result<(Vec<[f64; 3]>, Vec<[usize; 3]>), ShellError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| ShellError::io(path, "cannot read the mesh", e))?;
+    let (pos, tris, _, _) = parse_obj_surface(&text, &path.display().to_string())?;
+    Ok((pos, tris))
+}
+
+fn parse_obj_surface(text: &str, name: &str) -> Result<ObjSurface, ShellError> {
+    {
         let mut pos: Vec<[f64; 3]> = Vec::new();
         let mut vline: Vec<usize> = Vec::new();
         let mut tris = Vec::new();
@@ -213,6 +232,19 @@ impl Mesh {
                 message: "no faces".into(),
             });
         }
+        Ok((pos, tris, origin, vline))
+    }
+}
+
+impl Mesh {
+    /// The mesh of a parsed OBJ surface that must be flat in a plane z = const (the rest layout).
+    fn flat(
+        pos: Vec<[f64; 3]>,
+        tris: Vec<[usize; 3]>,
+        origin: Vec<String>,
+        vline: &[usize],
+        name: &str,
+    ) -> Result<(Mesh, Vec<[f64; 3]>), ShellError> {
         let (zmin, zmax) = pos
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {

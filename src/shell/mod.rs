@@ -13,8 +13,10 @@ pub mod strain;
 
 pub use strain::{strain, strain_reference, RestTriangle, StrainChain};
 pub mod assemble;
+pub mod dissipation;
 pub mod element;
 pub mod mesh;
+pub mod obstacle;
 pub mod render;
 pub mod scene;
 pub mod solver;
@@ -85,6 +87,9 @@ pub enum ShellError {
         file: String,
         source: Box<ShellError>,
     },
+    /// An obstacle mesh that cannot be used (not a manifold, consistently oriented triangle mesh).
+    #[error("{file}: {problem}")]
+    ObstacleMesh { file: String, problem: String },
     /// A scene's simulation could not be set up.
     #[error("{file}: {source}")]
     SceneSetup {
@@ -153,6 +158,21 @@ pub enum ShellError {
         time: f64,
         quantity: &'static str,
         value: f64,
+    },
+    /// A step that did not converge even at the smallest allowed substep: the run stops (what was written
+    /// stays); `hylc simulate` exits with code 3.
+    #[error(
+        "step {step} (t = {time:.4} s): Newton did not converge even with the time step halved {halvings} times \
+         (substep {dt:.3e} s; residual force {residual:.3e} N after {newton} iterations): a larger \
+         solver.max_newton or max_halvings, a smaller dt?"
+    )]
+    StepFailed {
+        step: usize,
+        time: f64,
+        halvings: u32,
+        dt: f64,
+        residual: f64,
+        newton: usize,
     },
     /// The Newton matrix of a step could not be factorised at any diagonal shift.
     #[error("step {step}: the Newton system could not be factorised even with a diagonal shift")]

@@ -431,7 +431,7 @@ fn stage_drape(
         log.event(e)
     })?;
     let png = dir.join("snapshot.png");
-    snapshot(&png, &scene, &o)?;
+    snapshot(&png, &o)?;
     let line = summary_line(&o.summary);
     log.line(&format!("simulate {}: {line}", args.scene))?;
     Ok((o, line))

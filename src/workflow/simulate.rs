@@ -2,9 +2,8 @@
 //! frames (`frame_NNNN.obj`), its step log (`log.jsonl`) and a PNG snapshot of the final state.
 
 use super::{Event, WorkflowError};
-use crate::shell::render::{sphere_mesh, write_png, Layer, View};
+use crate::shell::render::{write_png, Layer, View};
 use crate::shell::scene::{run, MeshSpec, RunSummary, Scene};
-use crate::shell::solver::Obstacle;
 use crate::shell::{Psd, ShellError};
 use std::path::{Path, PathBuf};
 
@@ -73,6 +72,8 @@ pub struct Outcome {
     pub summary: RunSummary,
     pub positions: Vec<[f64; 3]>,
     pub triangles: Vec<[usize; 3]>,
+    /// the obstacles' surfaces (spheres and meshes; planes have none), for pictures
+    pub obstacles: Vec<(Vec<[f64; 3]>, Vec<[usize; 3]>)>,
 }
 
 /// Build and run a scene, writing the frames and the log to `out`; reports the scene as an [`Event::Print`]
@@ -118,25 +119,18 @@ pub fn execute(
         summary,
         positions: sim.positions(),
         triangles: tris,
+        obstacles: sim.obstacles.iter().filter_map(|o| o.surface()).collect(),
     })
 }
 
-/// Write a PNG snapshot of the cloth (blue-grey) with the scene's sphere obstacles (light grey).
-pub fn snapshot(path: &Path, scene: &Scene, o: &Outcome) -> Result<(), WorkflowError> {
-    let spheres: Vec<_> = scene
-        .obstacles
-        .iter()
-        .filter_map(|ob| match ob {
-            Obstacle::Sphere { center, radius } => Some(sphere_mesh(*center, *radius, 48)),
-            Obstacle::Plane { .. } => None,
-        })
-        .collect();
+/// Write a PNG snapshot of the cloth (blue-grey) with the obstacles' surfaces (light grey).
+pub fn snapshot(path: &Path, o: &Outcome) -> Result<(), WorkflowError> {
     let mut layers = vec![Layer {
         positions: &o.positions,
         triangles: &o.triangles,
         color: [70, 110, 170],
     }];
-    for (x, t) in &spheres {
+    for (x, t) in &o.obstacles {
         layers.push(Layer {
             positions: x,
             triangles: t,

@@ -110,7 +110,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         );
     }
     let png = a.out.join("snapshot.png");
-    snapshot(&png, &scene, &o)?;
+    snapshot(&png, &o)?;
     println!("wrote {} (the final state)", png.display());
     if !complete(&o.summary) {
         eprintln!(

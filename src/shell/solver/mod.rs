@@ -1,69 +1,47 @@
-//! The cloth solver (`05-macro.md`, "The cloth solver"): implicit Euler as minimisation of the incremental
-//! potential, and a quasi-static mode.
+//! The cloth solver (`05-macro.md`, "The cloth solver"; issue 18): implicit Euler as minimisation of the
+//! incremental potential, adaptive substeps, and a quasi-static mode.
 //!
-//! Per step, with x̃ = xₙ + h vₙ, the free dofs minimise
-//! Φ(x) = ½‖x − x̃‖²_M / h² + (c/2h)‖x − xₙ‖²_M + E(x) − Σ m_v g·x_v + E_obst(x)
-//! (c the linear drag rate, 1/s: implicit drag force −c m v); quasi-static mode minimises E − Σ m g·x + E_obst.
-//! Newton's method with a backtracking (Armijo) line search on Φ; converged when the largest residual force on
-//! a free vertex, ‖∂Φ/∂x_v‖, is below the force tolerance. The sparse Hessian (free dofs only, the lower triangle
-//! in the pattern of [`assemble`](super::assemble)) is factorised by faer's sparse Cholesky with the symbolic
-//! analysis computed once per simulation. With `exact_first` (default) the exact Hessian is factorised first and
-//! the PSD option's Hessian (`05-macro.md`, options (a)–(c)) used only when that fails (not positive definite):
+//! Per (sub)step of length h, with x̃ = xₙ + h vₙ, the free dofs minimise
+//! Φ(x) = ½‖x − x̃‖²_M / h² + (c/2h)‖x − xₙ‖²_M + E(x) − Σ m_v g·x_v + E_obst(x) + D_fric(x)
+//!        + Σ_faces (D_damp + Π_drag) + Σ_held ½ k |x_v − p_v(t)|²
+//! (c the linear drag rate, 1/s: implicit drag force −c m v; the dissipation terms of [`dissipation`] and the
+//! obstacle terms of [`obstacle`] with their geometry lagged at xₙ; the last sum only with handle springs);
+//! quasi-static mode minimises E − Σ m g·x + E_obst (+ springs). Newton's method with a backtracking (Armijo)
+//! line search on Φ; converged when the largest residual force on a free vertex, ‖∂Φ/∂x_v‖, is below the force
+//! tolerance. The sparse Hessian (free dofs only, the lower triangle in the pattern of
+//! [`assemble`](super::assemble)) is factorised by faer's sparse Cholesky with the symbolic analysis computed
+//! once per simulation ([`linear`]). With `exact_first` (default) the exact Hessian is factorised first and the
+//! PSD option's Hessian (`05-macro.md`, options (a)–(c)) used only when that fails (not positive definite):
 //! projected Newton far from the solution, Newton's quadratic convergence near it. If the numeric factorisation
 //! of the projected Hessian fails (an indefinite matrix, possible with [`Psd::None`](super::Psd) or in
 //! quasi-static mode) a diagonal shift μ I is added and increased tenfold until it succeeds.
 //!
-//! Boundary conditions by dof elimination: pinned vertices keep their initial positions; handle vertices follow
-//! keyframed translations (piecewise linear in time, held after the last key). The reaction force of a handle is
-//! the force it exerts on the cloth, Σ over its vertices of m a + ∇E − m g − f_obst (quasi-static: ∇E − m g −
-//! f_obst).
+//! **Adaptive substeps.** A step of length dt that does not converge within `max_newton` iterations (or whose
+//! line search stalls, or whose start is degenerate) is retried from its start with h halved, down to
+//! dt / 2^`max_halvings`; after two converged substeps in a row h doubles again (never beyond dt, never past
+//! the end of the step). A step that fails at the smallest substep ends the run with
+//! [`ShellError::StepFailed`].
 //!
-//! Obstacles (spheres, planes): per vertex a smooth one-sided penalty E = m_v k p³/3 on the penetration
-//! p = δ − d > 0 into the layer of thickness δ around the surface (d the signed distance); C² at p = 0. Its
-//! Hessian keeps the PSD part 2 m k p n̂n̂ᵀ (the sphere's curvature term is negative and dropped).
+//! Boundary conditions: pinned vertices keep their initial positions; handle vertices follow keyframed
+//! translations (piecewise linear in time, held after the last key). By default both are hard constraints
+//! (dof elimination); with a handle stiffness k (ARCSim's `handle_stiffness`) every held vertex is instead free
+//! and pulled to its target by a spring ½ k |x − p(t)|². The reaction force of a handle is the force it exerts on
+//! the cloth: with hard constraints Σ over its vertices of ∂Φ/∂x_v (inertia, elastic, gravity, obstacle and
+//! dissipation terms), with springs Σ k (p_v − x_v).
 
-use super::assemble::{assemble, energy, gather, Assembled, Pattern};
+mod linear;
+mod terms;
+
+use super::assemble::{energy, gather, Assembled, Pattern};
+use super::dissipation::{self, Wind};
 use super::element::ElementModel;
 use super::mesh::Stencil;
+use super::obstacle::{self, Obstacle};
 use super::ShellError;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::SparseColMatRef;
+use faer::sparse::linalg::solvers::SymbolicLlt;
 use faer::Side;
-use rayon::prelude::*;
 use std::time::Instant;
-
-/// A rigid obstacle.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase", deny_unknown_fields)]
-pub enum Obstacle {
-    Sphere { center: [f64; 3], radius: f64 },
-    Plane { point: [f64; 3], normal: [f64; 3] },
-}
-
-impl Obstacle {
-    /// Signed distance and outward unit normal at p.
-    fn distance(&self, p: [f64; 3]) -> (f64, [f64; 3]) {
-        match self {
-            Obstacle::Sphere { center, radius } => {
-                let d = [p[0] - center[0], p[1] - center[1], p[2] - center[2]];
-                let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                if r > 0.0 {
-                    (r - radius, d.map(|x| x / r))
-                } else {
-                    (-radius, [0.0, 0.0, 1.0])
-                }
-            }
-            Obstacle::Plane { point, normal } => {
-                let l =
-                    (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt();
-                let n = normal.map(|x| x / l);
-                let d = (0..3).map(|k| (p[k] - point[k]) * n[k]).sum();
-                (d, n)
-            }
-        }
-    }
-}
+use terms::Lagged;
 
 /// A set of vertices following keyframed translations.
 #[derive(Clone, Debug)]
@@ -123,6 +101,18 @@ pub struct Settings {
     pub thickness: f64,
     /// obstacle penalty k (1/(m·s²)): E = m k p³/3
     pub contact_stiffness: f64,
+    /// Coulomb friction coefficient μ against obstacles
+    pub friction: f64,
+    /// sliding-velocity threshold ε_v of the smoothed friction (m/s)
+    pub friction_velocity: f64,
+    /// stiffness-proportional damping coefficient c (s)
+    pub damping: f64,
+    /// air drag
+    pub wind: Wind,
+    /// `None`: pins and handles are hard constraints; `Some(k)`: springs of stiffness k (N/m) per held vertex
+    pub handle_stiffness: Option<f64>,
+    /// a step is retried with h halved at most this many times
+    pub max_halvings: u32,
 }
 
 impl Default for Settings {
@@ -137,6 +127,12 @@ impl Default for Settings {
             drag: 0.0,
             thickness: 0.002,
             contact_stiffness: 1e8,
+            friction: 0.0,
+            friction_velocity: 1e-3,
+            damping: 0.0,
+            wind: Wind::default(),
+            handle_stiffness: None,
+            max_halvings: 6,
         }
     }
 }
@@ -146,7 +142,12 @@ impl Default for Settings {
 pub struct StepReport {
     pub step: usize,
     pub time: f64,
+    /// Newton iterations over all substeps
     pub newton: usize,
+    /// converged substeps the step took (1: none halved)
+    pub substeps: usize,
+    /// the smallest substep used (s)
+    pub dt_min: f64,
     /// largest residual force on a free vertex at the end (N)
     pub residual: f64,
     pub converged: bool,
@@ -249,15 +250,25 @@ pub struct Simulation {
     pub settings: Settings,
     pub time: f64,
     pub steps: usize,
+    /// current substep level: h = dt / 2^level
+    level: u32,
+    /// converged substeps in a row at the current level
+    streak: u32,
 }
 
-/// Per-step constants of the potential.
+/// Per-substep constants of the potential.
 struct Target {
+    /// substep length h
+    h: f64,
     xt: Vec<f64>,
     xn: Vec<f64>,
+    /// spring targets of the held vertices (vertex, position) when handles are springs
+    springs: Vec<(usize, [f64; 3])>,
+    /// geometry and forces frozen at xₙ (damping Hessians, drag faces, friction contacts)
+    lagged: Lagged,
 }
 
-/// Where the Newton iterations of a step ended.
+/// Where the Newton iterations of a substep ended.
 struct Minimum {
     x: Vec<f64>,
     /// Newton iterations taken
@@ -270,6 +281,16 @@ struct Minimum {
     /// the assembly and the full gradient of Φ at x
     asm: Assembled,
     g_full: Vec<f64>,
+}
+
+/// A substep's outcome: its minimum and constants, or why it must be retried with a smaller h.
+enum Substep {
+    Done(Box<(Minimum, Target)>),
+    Retry {
+        error: Option<ShellError>,
+        residual: f64,
+        newton: usize,
+    },
 }
 
 impl Simulation {
@@ -303,7 +324,7 @@ impl Simulation {
                     vertices: n,
                 });
             }
-            constrained[v] = true;
+            constrained[v] = settings.handle_stiffness.is_none();
         }
         let mut mass = vec![0.0; n];
         let rho = model.material.density * mass_multiplier;
@@ -338,6 +359,8 @@ impl Simulation {
             settings,
             time: 0.0,
             steps: 0,
+            level: 0,
+            streak: 0,
         })
     }
 
@@ -346,23 +369,24 @@ impl Simulation {
         self.x.chunks(3).map(|p| [p[0], p[1], p[2]]).collect()
     }
 
-    /// Obstacle energy, gradient and Hessian block of one vertex.
+    /// Obstacle penalty energy, gradient and (PSD) Hessian block of one vertex.
     fn obstacle_terms(&self, v: usize, p: [f64; 3]) -> (f64, [f64; 3], [[f64; 3]; 3]) {
         let mut e = 0.0;
         let mut g = [0.0; 3];
         let mut h = [[0.0; 3]; 3];
         let s = &self.settings;
         for o in &self.obstacles {
-            let (d, n) = o.distance(p);
-            let pen = s.thickness - d;
-            if pen > 0.0 {
-                let k = self.mass[v] * s.contact_stiffness;
-                e += k * pen * pen * pen / 3.0;
-                for a in 0..3 {
-                    g[a] -= k * pen * pen * n[a];
-                    for b in 0..3 {
-                        h[a][b] += 2.0 * k * pen * n[a] * n[b];
-                    }
+            let (eo, go, ho) = obstacle::penalty(
+                &o.proximity(p),
+                self.mass[v],
+                s.contact_stiffness,
+                s.thickness,
+            );
+            e += eo;
+            for a in 0..3 {
+                g[a] += go[a];
+                for b in 0..3 {
+                    h[a][b] += ho[a][b];
                 }
             }
         }
@@ -372,86 +396,77 @@ impl Simulation {
     /// Φ at x (None if a triangle is degenerate); relative to xₙ for the linear terms.
     fn potential(&self, x: &[f64], tg: &Target) -> Option<f64> {
         let mut phi = energy(&self.model, &self.stencils, x)?;
-        phi += self.external(x, tg).0;
+        phi += self.external_value(x, tg);
         Some(phi)
     }
 
-    /// The non-elastic part of Φ over free vertices: (value, unused).
-    fn external(&self, x: &[f64], tg: &Target) -> (f64, ()) {
-        let s = &self.settings;
-        let h = s.dt;
-        let val: f64 = (0..self.pattern.n)
-            .into_par_iter()
-            .with_min_len(1024)
-            .filter(|&v| self.pattern.free[v].is_some())
-            .map(|v| {
-                let m = self.mass[v];
-                let mut e = 0.0;
-                for c in 0..3 {
-                    let i = 3 * v + c;
-                    let dn = x[i] - tg.xn[i];
-                    if !s.quasi_static {
-                        let dt = x[i] - tg.xt[i];
-                        e += 0.5 * m * dt * dt / (h * h) + 0.5 * s.drag * m * dn * dn / h;
-                    }
-                    e -= m * s.gravity[c] * dn;
-                }
-                e + self
-                    .obstacle_terms(v, [x[3 * v], x[3 * v + 1], x[3 * v + 2]])
-                    .0
-            })
-            .sum();
-        (val, ())
-    }
-
-    /// Advance one step: minimise Φ from the start of the step ([`start_of_step`](Self::start_of_step)) by
-    /// Newton's method ([`minimise`](Self::minimise)), then take the minimiser as the new state.
+    /// Advance one step of length dt, in as many substeps as convergence needs (module documentation).
     pub fn step(&mut self) -> Result<StepReport, ShellError> {
         let start = Instant::now();
-        let h = self.settings.dt;
-        let t1 = self.time + h;
-        let (tg, x) = self.start_of_step(t1);
+        let dt = self.settings.dt;
+        let t_end = self.time + dt;
         let step = self.steps + 1;
-        let phi = match self.potential(&x, &tg) {
-            Some(phi) => phi,
-            None => {
-                return Err(
-                    non_finite_material(&self.model, &self.stencils, &x, Some(step))
-                        .unwrap_or(ShellError::DegenerateStart { step, time: t1 }),
-                )
+        let (mut newton, mut substeps, mut dt_min) = (0, 0, dt);
+        let mut max_shift: f64 = 0.0;
+        let mut last: Option<(Minimum, Target)> = None;
+        // the step ends when the remaining time is a round-off fraction of dt
+        while t_end - self.time > 1e-9 * dt {
+            let h = (dt / f64::from(1u32 << self.level)).min(t_end - self.time);
+            match self.substep(h, step)? {
+                Substep::Done(done) => {
+                    let (m, tg) = *done;
+                    newton += m.newton;
+                    substeps += 1;
+                    dt_min = dt_min.min(h);
+                    max_shift = max_shift.max(m.max_shift);
+                    self.accept(&m, &tg);
+                    self.streak += 1;
+                    if self.level > 0 && self.streak >= 2 {
+                        self.level -= 1;
+                        self.streak = 0;
+                    }
+                    last = Some((m, tg));
+                }
+                Substep::Retry {
+                    error,
+                    residual,
+                    newton: n,
+                } => {
+                    newton += n;
+                    self.streak = 0;
+                    if self.level >= self.settings.max_halvings {
+                        return Err(error.unwrap_or(ShellError::StepFailed {
+                            step,
+                            time: self.time,
+                            halvings: self.level,
+                            dt: h,
+                            residual,
+                            newton: n,
+                        }));
+                    }
+                    self.level += 1;
+                }
             }
-        };
-        let m = self.minimise(x, &tg, phi)?;
-        check_finite(step, t1, "largest residual force", m.residual)?;
-        check_finite(step, t1, "elastic energy", m.asm.energy)?;
-        // reactions: the full gradient of Φ at the handle vertices (`asm` and `g_full` are evaluated at x,
-        // except after a failed line search, where x did not change either)
-        let handle_forces = self.handle_forces(&m.g_full);
-        // update state
-        let x = m.x;
-        for i in 0..x.len() {
-            self.v[i] = if self.settings.quasi_static {
-                0.0
-            } else {
-                (x[i] - tg.xn[i]) / h
-            };
         }
-        self.x = x;
-        self.time = t1;
+        self.time = t_end;
         self.steps += 1;
+        let (m, _) = last.expect("a step of positive length takes a substep");
         let (ek, eg, eo) = self.energies();
         for (what, v) in [
             ("kinetic energy", ek),
             ("gravitational energy", eg),
             ("obstacle energy", eo),
         ] {
-            check_finite(step, t1, what, v)?;
+            check_finite(step, t_end, what, v)?;
         }
+        let handle_forces = self.handle_forces(&m.g_full);
         let asm = m.asm;
         Ok(StepReport {
             step: self.steps,
             time: self.time,
-            newton: m.newton,
+            newton,
+            substeps,
+            dt_min,
             residual: m.residual,
             converged: m.converged,
             energy_elastic: asm.energy,
@@ -459,7 +474,7 @@ impl Simulation {
             energy_gravity: eg,
             energy_obstacles: eo,
             handle_forces,
-            shift: m.max_shift,
+            shift: max_shift,
             wall: start.elapsed().as_secs_f64(),
             strain_min: asm.zmin,
             strain_max: asm.zmax,
@@ -468,12 +483,88 @@ impl Simulation {
         })
     }
 
-    /// The constants of the step ending at `t1` (x̃ = xₙ + h vₙ, xₙ) and the starting point of its minimisation:
-    /// pinned and handle vertices at their prescribed positions, the free ones at the inertial prediction x̃ when Φ
-    /// is defined there, else at xₙ (always xₙ in quasi-static mode).
-    fn start_of_step(&self, t1: f64) -> (Target, Vec<f64>) {
+    /// One substep of length h from the current state (not yet accepted). Errors a smaller h may cure
+    /// (degenerate start or iterate, failed factorisation, non-finite values) and unconverged Newton iterations
+    /// ask for a retry; others end the run.
+    fn substep(&self, h: f64, step: usize) -> Result<Substep, ShellError> {
+        let retry = |e: ShellError| match e {
+            ShellError::DegenerateStart { .. }
+            | ShellError::Degenerate { .. }
+            | ShellError::Factorization { .. }
+            | ShellError::NonFiniteState { .. } => Ok(Substep::Retry {
+                error: Some(e),
+                residual: f64::NAN,
+                newton: 0,
+            }),
+            e => Err(e),
+        };
+        let t1 = self.time + h;
+        let (tg, x) = match self.start_of_step(t1, h) {
+            Ok(v) => v,
+            Err(e) => return retry(e),
+        };
+        let phi = match self.potential(&x, &tg) {
+            Some(phi) => phi,
+            None => {
+                return retry(
+                    non_finite_material(&self.model, &self.stencils, &x, Some(step))
+                        .unwrap_or(ShellError::DegenerateStart { step, time: t1 }),
+                )
+            }
+        };
+        let m = match self.minimise(x, &tg, phi) {
+            Ok(m) => m,
+            Err(e) => return retry(e),
+        };
+        for (what, v) in [
+            ("largest residual force", m.residual),
+            ("elastic energy", m.asm.energy),
+        ] {
+            if let Err(e) = check_finite(step, t1, what, v) {
+                return retry(e);
+            }
+        }
+        if !m.converged {
+            return Ok(Substep::Retry {
+                error: None,
+                residual: m.residual,
+                newton: m.newton,
+            });
+        }
+        Ok(Substep::Done(Box::new((m, tg))))
+    }
+
+    /// Take a substep's minimiser as the new state.
+    fn accept(&mut self, m: &Minimum, tg: &Target) {
+        for i in 0..m.x.len() {
+            self.v[i] = if self.settings.quasi_static {
+                0.0
+            } else {
+                (m.x[i] - tg.xn[i]) / tg.h
+            };
+        }
+        self.x.clone_from(&m.x);
+        self.time += tg.h;
+    }
+
+    /// The prescribed position of every held vertex at time t (pins at x0, handles at x0 + offset).
+    fn held_targets(&self, t: f64) -> Vec<(usize, [f64; 3])> {
+        let at = |v: usize, o: [f64; 3]| (v, std::array::from_fn(|c| self.x0[3 * v + c] + o[c]));
+        let mut out: Vec<(usize, [f64; 3])> =
+            self.pinned.iter().map(|&v| at(v, [0.0; 3])).collect();
+        for hd in &self.handles {
+            let o = hd.offset(t);
+            out.extend(hd.vertices.iter().map(|&v| at(v, o)));
+        }
+        out
+    }
+
+    /// The constants of the substep ending at `t1` (x̃ = xₙ + h vₙ, xₙ, spring targets, lagged terms) and the
+    /// starting point of its minimisation: held vertices at their prescribed positions (hard constraints), the
+    /// free ones at the inertial prediction x̃ when Φ is defined there, else at xₙ (always xₙ in quasi-static
+    /// mode).
+    fn start_of_step(&self, t1: f64, h: f64) -> Result<(Target, Vec<f64>), ShellError> {
         let s = &self.settings;
-        let h = s.dt;
         let n = self.pattern.n;
         let xn = self.x.clone();
         let mut xt = xn.clone();
@@ -482,26 +573,24 @@ impl Simulation {
                 xt[i] += h * self.v[i];
             }
         }
-        // prescribed positions
+        let held = self.held_targets(t1);
         let mut x = xn.clone();
-        for &v in &self.pinned {
-            for c in 0..3 {
-                x[3 * v + c] = self.x0[3 * v + c];
+        let springs = if s.handle_stiffness.is_some() {
+            held
+        } else {
+            for &(v, p) in &held {
+                x[3 * v..3 * v + 3].copy_from_slice(&p);
             }
-        }
-        for hd in &self.handles {
-            let o = hd.offset(t1);
-            for &v in &hd.vertices {
-                for c in 0..3 {
-                    x[3 * v + c] = self.x0[3 * v + c] + o[c];
-                }
-            }
-        }
-        let tg = Target {
-            xt: xt.clone(),
-            xn: xn.clone(),
+            vec![]
         };
-        // initial guess: the inertial prediction when it is valid, else the previous positions
+        let lagged = self.lagged(&xn, h)?;
+        let tg = Target {
+            h,
+            xt: xt.clone(),
+            xn,
+            springs,
+            lagged,
+        };
         if !s.quasi_static {
             let mut guess = x.clone();
             for v in 0..n {
@@ -515,7 +604,7 @@ impl Simulation {
                 x = guess;
             }
         }
-        (tg, x)
+        Ok((tg, x))
     }
 
     /// Newton's method on Φ from `x` (where Φ = `phi`): converged when the largest residual force on a free
@@ -606,15 +695,20 @@ impl Simulation {
         None
     }
 
-    /// The force each handle exerts on the cloth: the sum of the full gradient of Φ over its vertices.
+    /// The force each handle exerts on the cloth: with hard constraints the sum of the full gradient of Φ over
+    /// its vertices, with springs the sum of the spring forces k (p_v − x_v) at the current state.
     fn handle_forces(&self, g_full: &[f64]) -> Vec<(String, [f64; 3])> {
         self.handles
             .iter()
             .map(|hd| {
                 let mut f = [0.0; 3];
+                let o = hd.offset(self.time);
                 for &v in &hd.vertices {
                     for c in 0..3 {
-                        f[c] += g_full[3 * v + c];
+                        f[c] += match self.settings.handle_stiffness {
+                            None => g_full[3 * v + c],
+                            Some(k) => k * (self.x0[3 * v + c] + o[c] - self.x[3 * v + c]),
+                        };
                     }
                 }
                 (hd.name.clone(), f)
@@ -645,132 +739,10 @@ impl Simulation {
     /// Newton iteration without the line search, for benchmarks. Returns the direction and the shift used.
     pub fn newton_direction(&self) -> Result<(Vec<f64>, f64), ShellError> {
         let h = self.settings.dt;
-        let xt: Vec<f64> = if self.settings.quasi_static {
-            self.x.clone()
-        } else {
-            self.x.iter().zip(&self.v).map(|(x, v)| x + h * v).collect()
-        };
-        let tg = Target {
-            xt,
-            xn: self.x.clone(),
-        };
+        let (tg, _) = self.start_of_step(self.time + h, h)?;
         let (asm, g) = self.gradient_hessian(&self.x, &tg)?;
-        let mut gf = vec![0.0; 3 * self.pattern.nfree];
-        for v in 0..self.pattern.n {
-            if let Some(k) = self.pattern.free[v] {
-                gf[3 * k..3 * k + 3].copy_from_slice(&g[3 * v..3 * v + 3]);
-            }
-        }
+        let (gf, _) = self.free_gradient(&g);
         self.solve(&asm.values, &asm.values_exact, &gf)
-    }
-
-    /// Assembled elastic terms plus the external ones: (assembly with the full Hessian values, full gradient
-    /// of Φ including constrained vertices — with their inertia — for the reaction forces).
-    fn gradient_hessian(
-        &self,
-        x: &[f64],
-        tg: &Target,
-    ) -> Result<(Assembled, Vec<f64>), ShellError> {
-        let s = &self.settings;
-        let h = s.dt;
-        let mut asm = assemble(
-            &self.model,
-            &self.stencils,
-            &self.pattern,
-            x,
-            true,
-            self.exact_first(),
-        )
-        .ok_or_else(|| {
-            let step = self.steps + 1;
-            non_finite_material(&self.model, &self.stencils, x, Some(step))
-                .unwrap_or(ShellError::Degenerate { step })
-        })?;
-        let mut g = std::mem::take(&mut asm.grad);
-        for v in 0..self.pattern.n {
-            let m = self.mass[v];
-            let p = [x[3 * v], x[3 * v + 1], x[3 * v + 2]];
-            let (_, go, ho) = self.obstacle_terms(v, p);
-            let mut blk = ho;
-            for c in 0..3 {
-                let i = 3 * v + c;
-                g[i] += go[c] - m * s.gravity[c];
-                if !s.quasi_static {
-                    g[i] += m * (x[i] - tg.xt[i]) / (h * h) + s.drag * m * (x[i] - tg.xn[i]) / h;
-                    blk[c][c] += m / (h * h) + s.drag * m / h;
-                }
-            }
-            if let Some(k) = self.pattern.free[v] {
-                self.pattern.add_diag_block(&mut asm.values, k, &blk);
-                if !asm.values_exact.is_empty() {
-                    self.pattern.add_diag_block(&mut asm.values_exact, k, &blk);
-                }
-            }
-        }
-        Ok((asm, g))
-    }
-
-    /// Whether the assembly also produces the exact Hessian (only useful when the PSD option changes it).
-    fn exact_first(&self) -> bool {
-        self.settings.exact_first && self.model.psd != super::Psd::None
-    }
-
-    /// Solve H d = −g with the reused symbolic analysis; returns d and the diagonal shift used. With
-    /// `exact` non-empty, the exact Hessian is tried first (Newton's own direction, quadratic convergence near the
-    /// solution) and the PSD option's `values` only when the exact one is not positive definite.
-    fn solve(
-        &self,
-        values: &[f64],
-        exact: &[f64],
-        g: &[f64],
-    ) -> Result<(Vec<f64>, f64), ShellError> {
-        let nf = g.len();
-        if !exact.is_empty() {
-            if let Some(d) = self.factor_solve(exact, g) {
-                return Ok((d, 0.0));
-            }
-        }
-        let mut shift = 0.0;
-        let mean_diag = self
-            .pattern
-            .lower
-            .diag
-            .iter()
-            .map(|&k| values[k].abs())
-            .sum::<f64>()
-            / nf as f64;
-        let mut vals = values.to_vec();
-        for attempt in 0..30 {
-            if attempt > 0 {
-                let new_shift = if shift == 0.0 {
-                    1e-8 * mean_diag.max(1e-300)
-                } else {
-                    10.0 * shift
-                };
-                for &k in &self.pattern.lower.diag {
-                    vals[k] += new_shift - shift;
-                }
-                shift = new_shift;
-            }
-            if let Some(d) = self.factor_solve(&vals, g) {
-                return Ok((d, shift));
-            }
-        }
-        Err(ShellError::Factorization {
-            step: self.steps + 1,
-        })
-    }
-
-    /// d = −H⁻¹ g for the free-dof matrix H with the lower-triangle `values` (the pattern's order): the numeric
-    /// Cholesky factorisation with the simulation's symbolic analysis, then one solve. `None` when H is not
-    /// positive definite or d is not finite.
-    fn factor_solve(&self, values: &[f64], g: &[f64]) -> Option<Vec<f64>> {
-        let nf = g.len();
-        let mat = SparseColMatRef::new(self.pattern.lower.symbolic(), values);
-        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower).ok()?;
-        let mut d: Vec<f64> = g.iter().map(|x| -x).collect();
-        llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut d, nf, 1));
-        d.iter().all(|x| x.is_finite()).then_some(d)
     }
 }
 

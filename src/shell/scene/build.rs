@@ -1,0 +1,152 @@
+//! From a scene to a simulation: material, mesh, selections, boundary conditions and settings.
+
+use super::*;
+
+impl Scene {
+    /// Load the material, build the mesh and the simulation. `file` names the scene in errors; relative paths
+    /// are resolved against `dir`.
+    pub fn build(
+        &self,
+        file: &str,
+        dir: &Path,
+    ) -> Result<(Simulation, Vec<[usize; 3]>), ShellError> {
+        self.validate(file)?;
+        let material = if self.material == "default" {
+            default_material()
+        } else {
+            let p = dir.join(&self.material);
+            Material::load(&p).map_err(|source| ShellError::Material {
+                file: file.to_string(),
+                source,
+            })?
+        };
+        let (mesh, x0) = match &self.mesh {
+            MeshSpec::Rectangle {
+                width,
+                height,
+                edge,
+                perturb,
+                seed,
+            } => {
+                let m = Mesh::rectangle(*width, *height, *edge, *perturb, *seed).map_err(|e| {
+                    ShellError::SceneMesh {
+                        file: file.to_string(),
+                        source: Box::new(e),
+                    }
+                })?;
+                let pl = &self.placement;
+                let x0 = m.place(pl.origin, pl.u, pl.v);
+                (m, x0)
+            }
+            MeshSpec::Obj { path, transform } => {
+                let (mut m, x) = Mesh::load_obj(&dir.join(path))?;
+                for r in m.rest.iter_mut() {
+                    *r = r.map(|c| c * transform.scale);
+                }
+                (m, x.into_iter().map(|p| transform.apply(p)).collect())
+            }
+        };
+        let stencils = mesh.stencils(self.fabric_angle_deg.to_radians())?;
+        let tris: Vec<[usize; 3]> = stencils.iter().map(|s| [s.v[0], s.v[1], s.v[2]]).collect();
+        let flags = ModelFlags {
+            bending: self.model.bending,
+            only_1d: self.model.only_1d,
+            in_plane_only: self.model.in_plane_only,
+            stiffness: self.model.stiffness,
+            bending_scale: self.model.bending_scale,
+        };
+        let model = ElementModel::new(&material, &flags, self.psd);
+        let mut pins = Vec::new();
+        for (i, sel) in self.pins.iter().enumerate() {
+            pins.extend(sel.select_checked(&mesh, &x0, file, format!("pins[{i}]"))?);
+        }
+        let mut handles = Vec::new();
+        for (i, h) in self.handles.iter().enumerate() {
+            let v = h
+                .select
+                .select_checked(&mesh, &x0, file, format!("handles[{i}].select"))?;
+            if v.iter().any(|x| pins.contains(x)) {
+                return Err(ShellError::Selection {
+                    file: file.to_string(),
+                    field: format!("handles[{i}].select"),
+                    problem: "overlaps a pin",
+                });
+            }
+            handles.push(Handle {
+                name: h.name.clone(),
+                vertices: v,
+                keyframes: h.keyframes.clone(),
+            });
+        }
+        let settings = Settings {
+            dt: self.dt,
+            quasi_static: self.quasi_static,
+            force_tol: self.solver.force_tol,
+            max_newton: self.solver.max_newton,
+            exact_first: self.solver.exact_first,
+            gravity: self.gravity,
+            drag: self.drag,
+            thickness: self.contact.thickness,
+            contact_stiffness: self.contact.stiffness,
+            friction: self.contact.friction,
+            friction_velocity: self.contact.friction_velocity,
+            damping: self.damping,
+            wind: self.wind,
+            handle_stiffness: self.handle_stiffness,
+            max_halvings: self.solver.max_halvings,
+        };
+        let obstacles = self.obstacles(file, dir)?;
+        let sim = Simulation::new(
+            model,
+            stencils,
+            x0,
+            Boundary {
+                pinned: pins,
+                handles,
+                obstacles,
+            },
+            settings,
+            self.model.mass,
+        )
+        .map_err(|e| ShellError::SceneSetup {
+            file: file.to_string(),
+            source: Box::new(e),
+        })?;
+        Ok((sim, tris))
+    }
+
+    /// The obstacles, with their meshes loaded, transformed and checked (errors name `obstacles[i]`).
+    pub fn obstacles(&self, file: &str, dir: &Path) -> Result<Vec<Obstacle>, ShellError> {
+        self.obstacles
+            .iter()
+            .enumerate()
+            .map(|(i, o)| {
+                Ok(match o {
+                    ObstacleSpec::Sphere { center, radius } => Obstacle::Sphere {
+                        center: *center,
+                        radius: *radius,
+                    },
+                    ObstacleSpec::Plane { point, normal } => Obstacle::Plane {
+                        point: *point,
+                        normal: *normal,
+                    },
+                    ObstacleSpec::Mesh { path, transform } => {
+                        let p = dir.join(path);
+                        let (v, t) = load_obj_surface(&p).map_err(|e| ShellError::SceneMesh {
+                            file: format!("{file}: obstacles[{i}]"),
+                            source: Box::new(e),
+                        })?;
+                        let v = v.into_iter().map(|q| transform.apply(q)).collect();
+                        let m = MeshObstacle::new(&p.display().to_string(), v, t).map_err(|e| {
+                            ShellError::SceneMesh {
+                                file: format!("{file}: obstacles[{i}]"),
+                                source: Box::new(e),
+                            }
+                        })?;
+                        Obstacle::Mesh(Box::new(m))
+                    }
+                })
+            })
+            .collect()
+    }
+}

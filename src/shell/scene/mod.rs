@@ -1,0 +1,463 @@
+//! Scenes (`05-macro.md`, "Scenes are JSON files; built-ins reproduce the original's tests"): the JSON format,
+//! the built-in scenes, and the runner that writes an OBJ per frame and a JSON-lines log per step.
+//!
+//! Format (unknown keys are errors; every key but `material`, `mesh` and `duration` has a default):
+//! ```json
+//! {
+//!   "material": "default",                       // or a material JSON path, relative to the scene file
+//!   "mesh": {"rectangle": {"width": 0.3, "height": 0.3, "edge": 0.006, "perturb": 0.0, "seed": 1}},
+//!                                                // or {"obj": {"path": "cloth.obj"}} (flat rest layout)
+//!   "placement": {"origin": [0,0,0], "u": [1,0,0], "v": [0,1,0]},   // rectangle: x = origin + X u + Y v
+//!   "fabric_angle_deg": 0.0,                     // fabric x axis against the mesh x axis
+//!   "duration": 1.0, "dt": 0.016666666666666666, "quasi_static": false,
+//!   "gravity": [0, 0, -9.81], "drag": 0.0,
+//!   "damping": 0.0,                              // stiffness-proportional damping coefficient c (s)
+//!   "wind": {"density": 0, "drag": 0, "velocity": [0, 0, 0]},   // air drag (ARCSim's wind)
+//!   "handle_stiffness": null,                    // null: pins and handles are hard constraints; a number k
+//!                                                // (N/m): each held vertex is a spring ½ k |x − target|²
+//!   "model": {"bending": true, "only_1d": false, "in_plane_only": false,
+//!             "stiffness": 1.0, "bending_scale": 1.0, "mass": 1.0},
+//!   "psd": "full",                               // "full" (18×18), "psi" (6×6), "none" (diagonal shift)
+//!   "solver": {"force_tol": 1e-6, "max_newton": 50, "exact_first": true, "max_halvings": 6},
+//!   "pins": [{"near": {"point": [0, 0], "radius": 0.01}}],
+//!   "handles": [{"name": "left", "select": {"box": {"min": [0, 0.05], "max": [0.021, 0.25]}},
+//!                "keyframes": [[0, [0, 0, 0]], [0.25, [-0.02, 0, 0]]]}],
+//!   "obstacles": [{"sphere": {"center": [0.15, 0.15, -0.032], "radius": 0.03}},
+//!                 {"plane": {"point": [0, 0, -0.5], "normal": [0, 0, 1]}},
+//!                 {"mesh": {"path": "sphere.obj", "transform": {"scale": 0.03, "translate": [0, 0, -0.04]}}}],
+//!   "contact": {"thickness": 0.002, "stiffness": 1e8, "friction": 0.0, "friction_velocity": 1e-3},
+//!   "output": {"obj_every": 1}
+//! }
+//! ```
+//! Selections are in rest-layout (mesh-plane) coordinates, metres; `{"ball": {"center": [x, y, z], "radius": r}}`
+//! selects by initial 3D position; `{"vertices": [..]}` lists 0-based vertex indices (OBJ order). An OBJ mesh's
+//! `transform` (`scale`, `translate`, `rotate`: [angle in degrees, axis x, y, z], applied in that order) places it:
+//! the rest layout is the scaled OBJ, the initial state the transformed one.
+
+pub use super::dissipation::Wind;
+use super::element::{ElementModel, ModelFlags, Psd};
+use super::mesh::{load_obj_surface, write_obj, Mesh};
+use super::obstacle::{MeshObstacle, Obstacle};
+use super::solver::{Boundary, Handle, Settings, Simulation, StepReport};
+use super::ShellError;
+use crate::material::synthetic::default_material;
+use crate::material::Material;
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+fn one() -> f64 {
+    1.0
+}
+fn yes() -> bool {
+    true
+}
+fn default_dt() -> f64 {
+    1.0 / 60.0
+}
+fn default_gravity() -> [f64; 3] {
+    [0.0, 0.0, -9.81]
+}
+fn default_psd() -> Psd {
+    Psd::Full
+}
+fn default_seed() -> u64 {
+    1
+}
+
+/// A scene file.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    #[serde(default)]
+    pub name: String,
+    pub material: String,
+    pub mesh: MeshSpec,
+    #[serde(default)]
+    pub placement: Placement,
+    #[serde(default)]
+    pub fabric_angle_deg: f64,
+    pub duration: f64,
+    #[serde(default = "default_dt")]
+    pub dt: f64,
+    #[serde(default)]
+    pub quasi_static: bool,
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 3],
+    #[serde(default)]
+    pub drag: f64,
+    #[serde(default)]
+    pub damping: f64,
+    #[serde(default)]
+    pub wind: Wind,
+    #[serde(default)]
+    pub handle_stiffness: Option<f64>,
+    #[serde(default)]
+    pub model: ModelSpec,
+    #[serde(default = "default_psd")]
+    pub psd: Psd,
+    #[serde(default)]
+    pub solver: SolverSpec,
+    #[serde(default)]
+    pub pins: Vec<Selection>,
+    #[serde(default)]
+    pub handles: Vec<HandleSpec>,
+    #[serde(default)]
+    pub obstacles: Vec<ObstacleSpec>,
+    #[serde(default)]
+    pub contact: ContactSpec,
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum MeshSpec {
+    Rectangle {
+        width: f64,
+        height: f64,
+        edge: f64,
+        #[serde(default)]
+        perturb: f64,
+        #[serde(default = "default_seed")]
+        seed: u64,
+    },
+    Obj {
+        path: String,
+        #[serde(default, skip_serializing_if = "Transform::is_identity")]
+        transform: Transform,
+    },
+}
+
+/// A rigid placement with a uniform scale (ARCSim's `transform`): x ↦ R(s x) + t, R the rotation by
+/// `rotate[0]` degrees about the axis `rotate[1..4]`.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct Transform {
+    pub scale: f64,
+    pub translate: [f64; 3],
+    pub rotate: [f64; 4],
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Transform {
+            scale: 1.0,
+            translate: [0.0; 3],
+            rotate: [0.0, 0.0, 0.0, 1.0],
+        }
+    }
+}
+
+impl Transform {
+    pub fn is_identity(&self) -> bool {
+        *self == Transform::default()
+    }
+
+    /// The rotation matrix (Rodrigues); the identity for a zero angle or axis.
+    pub fn rotation(&self) -> [[f64; 3]; 3] {
+        let [deg, x, y, z] = self.rotate;
+        let l = (x * x + y * y + z * z).sqrt();
+        let id = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        if deg == 0.0 || l == 0.0 {
+            return id;
+        }
+        let k = [x / l, y / l, z / l];
+        let (sn, cs) = deg.to_radians().sin_cos();
+        let kx = [[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]];
+        std::array::from_fn(|i| {
+            std::array::from_fn(|j| id[i][j] * cs + sn * kx[i][j] + (1.0 - cs) * k[i] * k[j])
+        })
+    }
+
+    /// R(s p) + t.
+    pub fn apply(&self, p: [f64; 3]) -> [f64; 3] {
+        let r = self.rotation();
+        std::array::from_fn(|i| {
+            (0..3).map(|j| r[i][j] * self.scale * p[j]).sum::<f64>() + self.translate[i]
+        })
+    }
+}
+
+/// An obstacle of a scene file (a mesh is loaded when the scene is built).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum ObstacleSpec {
+    Sphere {
+        center: [f64; 3],
+        radius: f64,
+    },
+    Plane {
+        point: [f64; 3],
+        normal: [f64; 3],
+    },
+    Mesh {
+        path: String,
+        #[serde(default, skip_serializing_if = "Transform::is_identity")]
+        transform: Transform,
+    },
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Placement {
+    pub origin: [f64; 3],
+    pub u: [f64; 3],
+    pub v: [f64; 3],
+}
+
+impl Default for Placement {
+    fn default() -> Self {
+        Placement {
+            origin: [0.0; 3],
+            u: [1.0, 0.0, 0.0],
+            v: [0.0, 1.0, 0.0],
+        }
+    }
+}
+
+/// "Model only what a scene requires" (`ModelFlags`) plus the mass multiplier.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    #[serde(default = "yes")]
+    pub bending: bool,
+    #[serde(default)]
+    pub only_1d: bool,
+    #[serde(default)]
+    pub in_plane_only: bool,
+    #[serde(default = "one")]
+    pub stiffness: f64,
+    #[serde(default = "one")]
+    pub bending_scale: f64,
+    #[serde(default = "one")]
+    pub mass: f64,
+}
+
+impl Default for ModelSpec {
+    fn default() -> Self {
+        ModelSpec {
+            bending: true,
+            only_1d: false,
+            in_plane_only: false,
+            stiffness: 1.0,
+            bending_scale: 1.0,
+            mass: 1.0,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverSpec {
+    pub force_tol: f64,
+    pub max_newton: usize,
+    pub exact_first: bool,
+    /// a step whose Newton iterations do not converge is retried with the time step halved, at most this many
+    /// times (6: down to 1/64 of it)
+    pub max_halvings: u32,
+}
+
+impl Default for SolverSpec {
+    fn default() -> Self {
+        let s = Settings::default();
+        SolverSpec {
+            force_tol: s.force_tol,
+            max_newton: s.max_newton,
+            exact_first: s.exact_first,
+            max_halvings: s.max_halvings,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    pub thickness: f64,
+    pub stiffness: f64,
+    /// Coulomb friction coefficient μ against obstacles (lagged friction)
+    #[serde(default)]
+    pub friction: f64,
+    /// sliding-velocity threshold ε_v (m/s) of the smoothed friction
+    #[serde(default = "default_friction_velocity")]
+    pub friction_velocity: f64,
+}
+
+fn default_friction_velocity() -> f64 {
+    Settings::default().friction_velocity
+}
+
+impl Default for ContactSpec {
+    fn default() -> Self {
+        let s = Settings::default();
+        ContactSpec {
+            thickness: s.thickness,
+            stiffness: s.contact_stiffness,
+            friction: s.friction,
+            friction_velocity: s.friction_velocity,
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// write an OBJ every this many frames (0: none)
+    pub obj_every: usize,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec { obj_every: 1 }
+    }
+}
+
+/// A vertex selection in rest-layout coordinates.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum Selection {
+    Box { min: [f64; 2], max: [f64; 2] },
+    Near { point: [f64; 2], radius: f64 },
+    Ball { center: [f64; 3], radius: f64 },
+    Vertices(Vec<usize>),
+}
+
+impl Selection {
+    /// The first listed vertex index the mesh of `vertices` vertices does not have (only `{"vertices": [..]}`
+    /// lists indices).
+    fn out_of_range(&self, vertices: usize) -> Option<usize> {
+        match self {
+            Selection::Vertices(list) => list.iter().copied().find(|&v| v >= vertices),
+            _ => None,
+        }
+    }
+
+    /// The selection's vertices, or an error naming `field` when it lists a vertex the mesh does not have or
+    /// selects none.
+    fn select_checked(
+        &self,
+        mesh: &Mesh,
+        x0: &[[f64; 3]],
+        file: &str,
+        field: String,
+    ) -> Result<Vec<usize>, ShellError> {
+        if let Some(index) = self.out_of_range(mesh.len()) {
+            return Err(ShellError::SelectionIndex {
+                file: file.to_string(),
+                field,
+                index,
+                vertices: mesh.len(),
+            });
+        }
+        let v = self.select(mesh, x0);
+        if v.is_empty() {
+            return Err(ShellError::Selection {
+                file: file.to_string(),
+                field,
+                problem: "selects no vertex",
+            });
+        }
+        Ok(v)
+    }
+
+    /// The selected vertices; `x0` the initial positions (for `ball`).
+    pub fn select(&self, mesh: &Mesh, x0: &[[f64; 3]]) -> Vec<usize> {
+        let eps = 1e-9;
+        (0..mesh.len())
+            .filter(|&v| {
+                let p = mesh.rest[v];
+                match self {
+                    Selection::Box { min, max } => {
+                        (0..2).all(|k| p[k] >= min[k] - eps && p[k] <= max[k] + eps)
+                    }
+                    Selection::Near { point, radius } => {
+                        (p[0] - point[0]).hypot(p[1] - point[1]) <= radius + eps
+                    }
+                    Selection::Ball { center, radius } => {
+                        let q = x0[v];
+                        let d2: f64 = (0..3).map(|k| (q[k] - center[k]).powi(2)).sum();
+                        d2.sqrt() <= radius + eps
+                    }
+                    Selection::Vertices(list) => list.contains(&v),
+                }
+            })
+            .collect()
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct HandleSpec {
+    pub name: String,
+    pub select: Selection,
+    pub keyframes: Vec<(f64, [f64; 3])>,
+}
+
+/// The most time steps a scene may take (⌈duration / dt⌉): a million steps are hours of wall time even on the
+/// smallest meshes (the built-ins take 60, `hylc run`'s drape 240); checked before the simulation is built.
+pub const MAX_STEPS: usize = 1_000_000;
+
+/// The smallest time step (s) a dynamic scene accepts: the inertia term m/dt² of the Newton matrix grows as
+/// 1/dt², and below a nanosecond it swamps the elastic terms by more than the precision of a double.
+pub const MIN_DT: f64 = 1e-9;
+
+/// The largest coordinate or length (m) a scene accepts in its placement origin, handle offsets and obstacles: a
+/// thousand kilometres, far beyond any cloth, and far from overflow when squared.
+pub const MAX_COORDINATE: f64 = 1e6;
+
+/// The largest component of the placement axes `u` and `v` (they scale the rest layout into the initial state;
+/// unit vectors place it unstretched).
+pub const MAX_AXIS: f64 = 1e3;
+
+/// The largest gravity magnitude (m/s²) a scene accepts: a thousand times the Earth's, far beyond any cloth
+/// experiment, and small enough that the forces m g stay many orders of magnitude from overflow.
+pub const MAX_GRAVITY: f64 = 1e4;
+
+/// The most Newton iterations per step a scene may ask for (`solver.max_newton`): the default is 50; more than
+/// 10 000 only delays the report of a step that does not converge.
+pub const MAX_NEWTON: usize = 10_000;
+
+/// The most time-step halvings a scene may allow (`solver.max_halvings`): 2⁻²⁰ of a step is below any
+/// useful time scale of cloth.
+pub const MAX_HALVINGS: u32 = 20;
+
+impl Scene {
+    /// Parse scene JSON (a leading UTF-8 byte-order mark is skipped); `name` (the file) is used in error messages.
+    pub fn from_json_str(text: &str, name: &str) -> Result<Scene, ShellError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        serde_json::from_str(text).map_err(|source| ShellError::Json {
+            file: name.to_string(),
+            source,
+        })
+    }
+
+    /// Read a scene file, or a built-in by name when no such file exists.
+    pub fn load(arg: &str) -> Result<(Scene, PathBuf), ShellError> {
+        let p = Path::new(arg);
+        if !p.exists() {
+            if let Some(s) = builtin(arg) {
+                return Ok((s, PathBuf::from(".")));
+            }
+            return Err(ShellError::UnknownScene {
+                name: arg.to_string(),
+            });
+        }
+        let text = std::fs::read_to_string(p).map_err(|e| ShellError::io(p, "cannot read", e))?;
+        let s = Scene::from_json_str(&text, arg)?;
+        let dir = p.parent().map(Path::to_path_buf).unwrap_or_default();
+        Ok((s, dir))
+    }
+
+    /// Number of steps for the duration.
+    pub fn steps(&self) -> usize {
+        (self.duration / self.dt - 1e-9).ceil().max(0.0) as usize
+    }
+}
+
+mod build;
+mod builtin;
+mod run;
+mod validate;
+
+pub use builtin::{builtin, BUILTINS, BUILTIN_EDGE, SIDE};
+pub use run::{run, RunSummary};

@@ -1,0 +1,81 @@
+//! The runner: one OBJ per frame and one JSON line per step.
+
+use super::*;
+
+/// Summary of a run.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunSummary {
+    pub steps: usize,
+    pub triangles: usize,
+    pub vertices: usize,
+    pub newton_total: usize,
+    pub newton_max: usize,
+    pub unconverged_steps: usize,
+    pub max_residual: f64,
+    pub wall: f64,
+    pub last: Option<StepReport>,
+}
+
+/// Run a built simulation for `steps` steps, writing `frame_NNNN.obj` (frame 0 the initial state) every
+/// `obj_every` steps and one JSON line per step to `log.jsonl` in `out` (when given). `progress` is called after
+/// every step.
+pub fn run(
+    sim: &mut Simulation,
+    tris: &[[usize; 3]],
+    steps: usize,
+    obj_every: usize,
+    out: Option<&Path>,
+    mut progress: impl FnMut(&StepReport),
+) -> Result<RunSummary, ShellError> {
+    let io = |e: std::io::Error, what: &Path| ShellError::io(what, "cannot write", e);
+    let mut log = match out {
+        Some(dir) => {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| ShellError::io(dir, "cannot create the folder", e))?;
+            if obj_every > 0 {
+                let f = dir.join("frame_0000.obj");
+                write_obj(&f, &sim.positions(), tris).map_err(|e| io(e, &f))?;
+            }
+            let f = dir.join("log.jsonl");
+            Some((
+                std::io::BufWriter::new(std::fs::File::create(&f).map_err(|e| io(e, &f))?),
+                f,
+            ))
+        }
+        None => None,
+    };
+    let start = std::time::Instant::now();
+    let mut sum = RunSummary {
+        steps,
+        triangles: sim.stencils.len(),
+        vertices: sim.pattern.n,
+        newton_total: 0,
+        newton_max: 0,
+        unconverged_steps: 0,
+        max_residual: 0.0,
+        wall: 0.0,
+        last: None,
+    };
+    for k in 1..=steps {
+        let r = sim.step()?;
+        sum.newton_total += r.newton;
+        sum.newton_max = sum.newton_max.max(r.newton);
+        sum.unconverged_steps += usize::from(!r.converged);
+        sum.max_residual = sum.max_residual.max(r.residual);
+        if let (Some(dir), Some((w, f))) = (out, log.as_mut()) {
+            let line = serde_json::to_string(&r).expect("a step report serialises");
+            writeln!(w, "{line}").map_err(|e| io(e, f))?;
+            if obj_every > 0 && k % obj_every == 0 {
+                let f = dir.join(format!("frame_{k:04}.obj"));
+                write_obj(&f, &sim.positions(), tris).map_err(|e| io(e, &f))?;
+            }
+        }
+        progress(&r);
+        sum.last = Some(r);
+    }
+    if let Some((mut w, f)) = log {
+        w.flush().map_err(|e| io(e, &f))?;
+    }
+    sum.wall = start.elapsed().as_secs_f64();
+    Ok(sum)
+}
