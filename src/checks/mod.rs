@@ -7,6 +7,7 @@ pub mod material;
 pub mod micro;
 pub mod rod;
 pub mod shell;
+pub mod shell_external;
 pub mod tile;
 
 use crate::diff::{run_checks, Check, CheckConfig, Report};
@@ -20,6 +21,7 @@ pub fn registry() -> Vec<Box<dyn Check>> {
     checks.extend(tile::diff_checks());
     checks.extend(micro::diff_checks());
     checks.extend(shell::diff_checks());
+    checks.extend(shell_external::diff_checks());
     checks
 }
 

@@ -4,8 +4,8 @@
 //! **Distance.** d(p) is the signed distance of p to the obstacle's surface (positive outside) and n = ∇d its
 //! outward unit normal. A triangle mesh is queried through parry3d-f64's BVH ([`TriMesh`] with pseudo-normals,
 //! so that the inside of a closed mesh is told apart from the outside): with c the closest surface point,
-//! d = ±|p − c|, n = ±(p − c)/|p − c|; ∇²d = 0 where c lies inside a face, ±(I − n nᵀ)/|p − c| where it lies on
-//! an edge or a vertex (the sphere: (I − n nᵀ)/|p − centre|).
+//! d = ±|p − c|, n = ±(p − c)/|p − c|; ∇²d = 0 where c lies inside a face, ±(I − ê êᵀ − n nᵀ)/|p − c| where it
+//! lies on an edge of direction ê, ±(I − n nᵀ)/|p − c| at a vertex (the sphere: (I − n nᵀ)/|p − centre|).
 //!
 //! **Penalty.** With the layer thickness δ and the penetration p = δ − d > 0, E = m k p³/3 per vertex (m the
 //! vertex mass, k the stiffness in 1/(m s²)); C² at p = 0. ∇E = −m k p² n and
@@ -81,6 +81,25 @@ impl MeshObstacle {
             .position(|t| t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
         {
             return Err(bad(format!("triangle {t} repeats a vertex")));
+        }
+        // closed and consistently oriented: every directed edge once, and its reverse once
+        let mut edges = std::collections::HashMap::new();
+        for (t, tri) in triangles.iter().enumerate() {
+            for k in 0..3 {
+                let e = (tri[k], tri[(k + 1) % 3]);
+                if edges.insert(e, t).is_some() {
+                    return Err(bad(format!(
+                        "not a manifold, consistently oriented triangle mesh: the edge {}–{} is used twice in \
+                         the same direction (triangle {t})",
+                        e.0, e.1
+                    )));
+                }
+            }
+        }
+        if let Some(((a, b), t)) = edges.iter().find(|(e, _)| !edges.contains_key(&(e.1, e.0))) {
+            return Err(bad(format!(
+                "not a closed triangle mesh: the edge {a}–{b} of triangle {t} has no neighbour across it"
+            )));
         }
         // orient outward: a closed mesh wound inward has a negative signed volume
         let volume: f64 = triangles
@@ -199,7 +218,18 @@ impl Feature {
                 let w = sub3(p, a);
                 let t = dot3(w, e) / dot3(e, e).max(1e-300);
                 let v: [f64; 3] = std::array::from_fn(|k| w[k] - t * e[k]);
-                radial(v, sign, 0.0, [0.0, 0.0, 1.0])
+                let (d, n, mut hess) = radial(v, sign, 0.0, [0.0, 0.0, 1.0]);
+                // across the edge only: ∇²|P w| = (P − n nᵀ)/r with P = I − ê êᵀ
+                let r = dot3(v, v).sqrt();
+                if r > 0.0 {
+                    let ee = dot3(e, e).max(1e-300);
+                    for (a, row) in hess.iter_mut().enumerate() {
+                        for (b, h) in row.iter_mut().enumerate() {
+                            *h -= sign / r * e[a] * e[b] / ee;
+                        }
+                    }
+                }
+                (d, n, hess)
             }
             Feature::Vertex { a, sign } => radial(sub3(p, a), sign, 0.0, [0.0, 0.0, 1.0]),
         };

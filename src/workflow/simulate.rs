@@ -140,10 +140,14 @@ pub fn snapshot(path: &Path, o: &Outcome) -> Result<(), WorkflowError> {
     Ok(write_png(path, &layers, &View::default())?)
 }
 
-/// Whether `e` is a simulation that diverged (a non-finite residual or energy, [`ShellError::NonFiniteState`]):
+/// Whether `e` is a simulation that diverged (a non-finite residual or energy, [`ShellError::NonFiniteState`]) or
+/// a step that did not converge at the smallest substep ([`ShellError::StepFailed`]):
 /// the computation did not converge (exit code 3), as opposed to bad input (exit code 2).
 pub fn diverged(e: &WorkflowError) -> bool {
-    matches!(e, WorkflowError::Shell(ShellError::NonFiniteState { .. }))
+    matches!(
+        e,
+        WorkflowError::Shell(ShellError::NonFiniteState { .. } | ShellError::StepFailed { .. })
+    )
 }
 
 /// Whether a finished run is complete (`05-macro.md`, exit codes of `hylc simulate`): its last step converged
