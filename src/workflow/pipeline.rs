@@ -49,7 +49,7 @@ pub struct RunConfig {
 
 impl Default for RunConfig {
     /// The defaults of `hylc run`: the generated stockinette, the quick plan, the `drape-x` scene at 1 cm edges
-    /// and 1/240 s, in `out/run`.
+    /// and 1/60 s (adaptive substeps inside), in `out/run`.
     fn default() -> Self {
         RunConfig {
             out: PathBuf::from("out/run"),
@@ -58,7 +58,7 @@ impl Default for RunConfig {
             scene: "drape-x".into(),
             edge: Some(0.01),
             duration: None,
-            dt: 1.0 / 240.0,
+            dt: 1.0 / 60.0,
             fresh: false,
             construction: None,
         }

@@ -36,9 +36,9 @@ pub struct Args {
     /// simulated time (s) instead of the scene's
     #[arg(long)]
     duration: Option<f64>,
-    /// time step of the cloth simulation (s); 1/240 by default: a knit's rest curl makes the cloth crumple at
-    /// the mesh scale, and at the scenes' 1/60 Newton no longer converges
-    #[arg(long, default_value_t = 1.0 / 240.0)]
+    /// time step of the cloth simulation (s); 1/60 by default, with adaptive substeps inside a step when Newton
+    /// does not converge (down to 1/64 of it)
+    #[arg(long, default_value_t = 1.0 / 60.0)]
     dt: f64,
     /// delete the output folder first instead of resuming
     #[arg(long)]
