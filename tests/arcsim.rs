@@ -560,3 +560,46 @@ fn the_originals_scenes_convert_and_build() {
         }
     }
 }
+
+#[test]
+fn damaged_scenes_are_errors_never_panics() {
+    let f = Fixture::new("damaged");
+    let good = full(&[bar(0, 0)]);
+    let chars: Vec<char> = good.chars().collect();
+    let dir = f.root.join("tests/conf");
+    let mut errors = 0;
+    for i in 0..chars.len() {
+        // the scene cut after i characters, and the scene without its i-th character
+        let cut: String = chars[..i].iter().collect();
+        let gap: String = chars[..i].iter().chain(&chars[i + 1..]).collect();
+        for text in [cut, gap] {
+            match arcsim::convert_str(&text, "damaged.json", &dir) {
+                Ok(_) => {}
+                Err(e) => {
+                    let msg = e.to_string();
+                    assert!(
+                        msg.starts_with("damaged.json:") && !msg.contains('\n'),
+                        "{msg}"
+                    );
+                    errors += 1;
+                }
+            }
+        }
+    }
+    assert!(errors > chars.len(), "{errors} errors");
+}
+
+#[test]
+fn our_scenes_and_builtins_are_not_taken_for_arcsim() {
+    for name in hylc::shell::scene::BUILTINS {
+        let s = hylc::shell::scene::builtin(name).unwrap();
+        let text = serde_json::to_string_pretty(&s).unwrap();
+        assert!(!arcsim::is_arcsim(&text), "{name}");
+        let (loaded, _, notes) = arcsim::load_scene(name).unwrap();
+        assert_eq!(loaded, s);
+        assert!(notes.is_empty());
+    }
+    assert!(arcsim::is_arcsim("{\"frame_time\": 0.01 // a comment\n}"));
+    assert!(arcsim::is_arcsim("{\"cloths\": [}"));
+    assert!(!arcsim::is_arcsim("{\"mesh\": 1, \"cloths\": []}"));
+}
