@@ -12,6 +12,7 @@
 pub mod strain;
 
 pub use strain::{strain, strain_reference, RestTriangle, StrainChain};
+pub mod arcsim;
 pub mod assemble;
 pub mod dissipation;
 pub mod element;
@@ -52,6 +53,23 @@ pub enum ShellError {
     /// Neither a scene file nor the name of a built-in scene.
     #[error("{name}: no such scene file and not a built-in scene ({})", scene::BUILTINS.join(", "))]
     UnknownScene { name: String },
+    /// An ARCSim scene file (`arcsim`) that is not JSON with comments: the file, line and column at fault.
+    #[error("{file}:{line}:{column}: not an ARCSim scene file: {message}")]
+    ArcsimSyntax {
+        file: String,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    /// A key of an ARCSim scene file (`arcsim`) that is missing, of the wrong type or out of range: the file,
+    /// the line of the value (or of the enclosing object for a missing key) and the key's path.
+    #[error("{file}:{line}: key `{key}`: {message}")]
+    Arcsim {
+        file: String,
+        line: usize,
+        key: String,
+        message: String,
+    },
     /// A scene field with a value the scene cannot use.
     #[error("{file}: field `{field}`: {message}")]
     Scene {

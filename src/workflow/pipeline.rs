@@ -9,7 +9,7 @@
 use super::fit::{fit_samples, FitJob};
 use super::inputs::{construction_of, load_pattern, load_plan};
 use super::sidecar::write_meta;
-use super::simulate::{execute, prepare, snapshot, summary_line, Outcome, Overrides};
+use super::simulate::{execute, prepare_noted, snapshot, summary_line, Outcome, Overrides};
 use super::{write_file, Event, WorkflowError};
 use crate::fit::model::FitReport;
 use crate::micro::reference::{reference_state, Construction, ReferenceOptions};
@@ -423,7 +423,7 @@ fn stage_drape(
         edge: args.edge,
         ..Overrides::default()
     };
-    let (mut scene, scene_dir) = prepare(&args.scene, &ov)?;
+    let (mut scene, scene_dir) = prepare_noted(&args.scene, &ov, &mut |e| log.event(e))?;
     // frames at 60 per simulated second whatever the step
     scene.output.obj_every = ((1.0 / 60.0) / args.dt).round().max(1.0) as usize;
     let sim_dir = dir.join("simulate");

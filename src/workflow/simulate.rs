@@ -23,9 +23,23 @@ pub struct Overrides {
 }
 
 /// The scene `scene_arg` (a JSON file or a built-in) after the overrides, with the folder its relative paths
-/// start from.
+/// start from. An ARCSim scene file is converted (issue 18; [`crate::shell::arcsim`]); its conversion warnings are
+/// dropped here ([`prepare_noted`] reports them).
 pub fn prepare(scene_arg: &str, ov: &Overrides) -> Result<(Scene, PathBuf), WorkflowError> {
-    let (mut scene, dir) = Scene::load(scene_arg)?;
+    prepare_noted(scene_arg, ov, &mut |_| {})
+}
+
+/// [`prepare`], reporting the warnings of an ARCSim scene's conversion (issue 18: one line per ignored or unknown
+/// key) as [`Event::Note`]s.
+pub fn prepare_noted(
+    scene_arg: &str,
+    ov: &Overrides,
+    on_event: &mut dyn FnMut(Event),
+) -> Result<(Scene, PathBuf), WorkflowError> {
+    let (mut scene, dir, warnings) = crate::shell::arcsim::load_scene(scene_arg)?;
+    for w in &warnings {
+        on_event(Event::Note(w));
+    }
     if let Some(m) = &ov.material {
         // a path given on the command line is relative to the working directory
         scene.material = if m == "default" {

@@ -5,12 +5,13 @@ use crate::printer::Printer;
 use clap::ValueEnum;
 use hylc::shell::Psd;
 use hylc::workflow::simulate::{
-    complete, diverged, execute, prepare, snapshot, summary_line, Overrides,
+    complete, diverged, execute, prepare_noted, snapshot, summary_line, Overrides,
 };
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-/// Simulate a cloth scene: a scene JSON file or a built-in (stretch-x, stretch-y, drape-x, drape-y, hanging).
+/// Simulate a cloth scene: a scene JSON file, an ARCSim-HYLC scene file (converted; warnings name the keys it
+/// ignores) or a built-in (stretch-x, stretch-y, drape-x, drape-y, hanging).
 /// Writes frame_NNNN.obj per frame and log.jsonl (one JSON object per step) to the output folder. Exit code 0:
 /// complete (the last step converged); 2: bad input; 3: did not converge (the last step ended at the Newton cap,
 /// or a residual or energy became non-finite, which stops the run).
@@ -48,7 +49,8 @@ pub struct Args {
     /// no progress bar
     #[arg(long)]
     quiet: bool,
-    /// print the scene (after overrides) as JSON and exit
+    /// print the scene (after overrides) as JSON and exit; an ARCSim scene prints converted to our format (its
+    /// paths relative to its folder: save it there)
     #[arg(long)]
     print: bool,
 }
@@ -82,12 +84,12 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         only_1d: a.only_1d,
         in_plane_only: a.in_plane_only,
     };
-    let (scene, dir) = prepare(&a.scene, &ov)?;
+    let mut printer = Printer::new(a.quiet);
+    let (scene, dir) = prepare_noted(&a.scene, &ov, &mut |e| printer.show(e))?;
     if a.print {
         println!("{}", serde_json::to_string_pretty(&scene)?);
         return Ok(ExitCode::SUCCESS);
     }
-    let mut printer = Printer::new(a.quiet);
     let o = match execute(&scene, &a.scene, &dir, &a.out, &mut |e| printer.show(e)) {
         Ok(o) => o,
         Err(e) if diverged(&e) => {

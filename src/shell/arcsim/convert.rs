@@ -1,0 +1,486 @@
+//! From a parsed ARCSim scene to our [`Scene`] (issue 18, Deliver 1; the mapping of every key is listed in
+//! `README-arcsim.md`).
+
+use super::handlebar::{Handlebar, SIDES};
+use super::json::Node;
+use super::read::{join, Ctx, Key};
+use crate::shell::scene::{
+    ContactSpec, HandleSpec, MeshSpec, ModelSpec, ObstacleSpec, OutputSpec, Placement, Scene,
+    Selection, SolverSpec, Transform, Wind,
+};
+use crate::shell::{Mesh, Psd, ShellError};
+
+use Key::{Ignored, Used};
+
+/// ARCSim's defaults for keys a scene may leave out (its `conf.cpp`, and the issue for the magic numbers):
+/// `wind.density` 1, `magic.handle_stiffness` 1e3 N/m, `magic.repulsion_thickness` 1e-3 m, `obs_friction` 0.3,
+/// `gravity` zero, `frame_steps` 1.
+pub const DEFAULT_WIND_DENSITY: f64 = 1.0;
+pub const DEFAULT_HANDLE_STIFFNESS: f64 = 1e3;
+pub const DEFAULT_REPULSION_THICKNESS: f64 = 1e-3;
+pub const DEFAULT_OBS_FRICTION: f64 = 0.3;
+
+const REMESHING: &str =
+    "adaptive remeshing is not part of the HYLC model (the cloth keeps its mesh)";
+
+/// One motion: piecewise-linear translation keyframes (time, offset).
+type Motion = Vec<(f64, [f64; 3])>;
+
+/// Convert the scene `root`; `name` is the produced scene's name.
+pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, ShellError> {
+    let top = ctx.fields(
+        root,
+        "",
+        &[
+            ("hylc", Used),
+            ("frame_time", Used),
+            ("frame_steps", Used),
+            ("end_time", Used),
+            ("cloths", Used),
+            ("wind", Used),
+            ("motions", Used),
+            ("handlebars", Used),
+            ("handlespheres", Used),
+            ("obstacles", Used),
+            ("gravity", Used),
+            ("obs_friction", Used),
+            ("magic", Used),
+            ("remeshing", Ignored(REMESHING)),
+            (
+                "disable",
+                Ignored("ARCSim's module switches (remeshing, collision, …) do not apply here"),
+            ),
+            (
+                "implicit",
+                Ignored("every step here is implicit (incremental-potential minimisation)"),
+            ),
+            (
+                "friction",
+                Ignored("cloth–cloth friction: there is no cloth self-contact here"),
+            ),
+        ],
+    )?;
+    let line = root.line;
+
+    // the HYLC material and model
+    let hylc_node = ctx.required(&top, line, "", "hylc")?;
+    let hylc = ctx.fields(
+        hylc_node,
+        "hylc",
+        &[
+            ("material", Used),
+            ("only1D", Used),
+            (
+                "enabled",
+                Ignored("the HYLC material (hylc.material) is always the cloth's material here"),
+            ),
+        ],
+    )?;
+    let mat_node = ctx.required(&hylc, hylc_node.line, "hylc", "material")?;
+    let (material, _) = ctx.resolve(mat_node, "hylc.material")?;
+    let only_1d = match hylc.get("only1D") {
+        Some(n) => ctx.boolean(n, "hylc.only1D")?,
+        None => false,
+    };
+
+    // time
+    let dt = ctx.positive(ctx.required(&top, line, "", "frame_time")?, "frame_time")?;
+    let duration = ctx.non_negative(ctx.required(&top, line, "", "end_time")?, "end_time")?;
+    if let Some(n) = top.get("frame_steps") {
+        let k = ctx.number(n, "frame_steps")?;
+        if !(k >= 1.0 && k.fract() == 0.0) {
+            return Err(ctx.error(
+                n.line,
+                "frame_steps",
+                format!("must be a positive whole number, got {k}"),
+            ));
+        }
+        ctx.warn(
+            n.line,
+            "frame_steps",
+            &format!(
+                "ignored: the original's {k} substeps of {:.3e} s per frame; here one implicit step per frame \
+                 (dt = frame_time = {dt} s), halved adaptively when Newton needs it",
+                dt / k
+            ),
+        );
+    }
+
+    // the cloth
+    let cloths_node = ctx.required(&top, line, "", "cloths")?;
+    let cloths = ctx.array(cloths_node, "cloths")?;
+    if cloths.len() != 1 {
+        return Err(ctx.error(
+            cloths_node.line,
+            "cloths",
+            format!(
+                "one cloth is simulated here, the scene has {}",
+                cloths.len()
+            ),
+        ));
+    }
+    let c0 = &cloths[0];
+    let cloth = ctx.fields(
+        c0,
+        "cloths[0]",
+        &[
+            ("mesh", Used),
+            ("transform", Used),
+            ("materials", Used),
+            ("remeshing", Ignored(REMESHING)),
+        ],
+    )?;
+    let mesh_node = ctx.required(&cloth, c0.line, "cloths[0]", "mesh")?;
+    let (mesh_rel, mesh_path) = ctx.resolve(mesh_node, "cloths[0].mesh")?;
+    let transform = match cloth.get("transform") {
+        Some(n) => read_transform(ctx, n, "cloths[0].transform")?,
+        None => Transform::default(),
+    };
+    let materials = ctx.required(&cloth, c0.line, "cloths[0]", "materials")?;
+    let damping = read_materials(ctx, materials)?;
+    // the rest layout and the initial state exactly as `Scene::build` makes them
+    let (mut mesh, x) = Mesh::load_obj(&mesh_path)
+        .map_err(|e| ctx.error(mesh_node.line, "cloths[0].mesh", e.to_string()))?;
+    for r in mesh.rest.iter_mut() {
+        *r = r.map(|c| c * transform.scale);
+    }
+    let x0: Vec<[f64; 3]> = x.into_iter().map(|p| transform.apply(p)).collect();
+
+    // air
+    let wind = match top.get("wind") {
+        None => Wind {
+            density: DEFAULT_WIND_DENSITY,
+            drag: 0.0,
+            velocity: [0.0; 3],
+        },
+        Some(n) => {
+            let f = ctx.fields(
+                n,
+                "wind",
+                &[("density", Used), ("drag", Used), ("velocity", Used)],
+            )?;
+            Wind {
+                density: match f.get("density") {
+                    Some(d) => ctx.non_negative(d, "wind.density")?,
+                    None => DEFAULT_WIND_DENSITY,
+                },
+                drag: match f.get("drag") {
+                    Some(d) => ctx.non_negative(d, "wind.drag")?,
+                    None => 0.0,
+                },
+                velocity: match f.get("velocity") {
+                    Some(v) => ctx.numbers::<3>(v, "wind.velocity")?,
+                    None => [0.0; 3],
+                },
+            }
+        }
+    };
+
+    // motions, handlebars (moving strips), handlespheres (fixed)
+    let motions = match top.get("motions") {
+        Some(n) => read_motions(ctx, n)?,
+        None => Vec::new(),
+    };
+    let mut handles: Vec<HandleSpec> = Vec::new();
+    let mut held_by_bars: Vec<Vec<usize>> = Vec::new();
+    if let Some(n) = top.get("handlebars") {
+        for (i, b) in ctx.array(n, "handlebars")?.iter().enumerate() {
+            let path = format!("handlebars[{i}]");
+            let f = ctx.fields(
+                b,
+                &path,
+                &[
+                    ("side", Used),
+                    ("lengthp", Used),
+                    ("widthp", Used),
+                    ("insetp", Used),
+                    ("motion", Used),
+                ],
+            )?;
+            let req = |k: &str| ctx.required(&f, b.line, &path, k);
+            let side = ctx.index(
+                req("side")?,
+                &join(&path, "side"),
+                4,
+                "0 (left), 1 (bottom), 2 (right) or 3 (top)",
+            )?;
+            let bar = Handlebar {
+                side,
+                lengthp: ctx.fraction(req("lengthp")?, &join(&path, "lengthp"))?,
+                widthp: ctx.fraction(req("widthp")?, &join(&path, "widthp"))?,
+                insetp: ctx.fraction(req("insetp")?, &join(&path, "insetp"))?,
+            };
+            let what = match motions.len() {
+                0 => "the index of a motion, but the scene has no `motions`".to_string(),
+                m => format!("the index of one of the scene's {m} motions (0-based)"),
+            };
+            let motion = ctx.index(req("motion")?, &join(&path, "motion"), motions.len(), &what)?;
+            let (select, held) = bar.selection(&mesh, &x0);
+            if held.is_empty() {
+                return Err(ctx.error(
+                    b.line,
+                    &path,
+                    "selects no vertex of the cloth (no vertex lies strictly inside its strip)",
+                ));
+            }
+            let mut name = SIDES[side].to_string();
+            if handles.iter().any(|h| h.name == name) {
+                name = format!("{name}-{i}");
+            }
+            handles.push(HandleSpec {
+                name,
+                select,
+                keyframes: motions[motion].clone(),
+            });
+            held_by_bars.push(held);
+        }
+    }
+    let mut pins = Vec::new();
+    if let Some(n) = top.get("handlespheres") {
+        for (i, s) in ctx.array(n, "handlespheres")?.iter().enumerate() {
+            let path = format!("handlespheres[{i}]");
+            let f = ctx.fields(s, &path, &[("center", Used), ("radius", Used)])?;
+            let center = ctx.numbers::<3>(
+                ctx.required(&f, s.line, &path, "center")?,
+                &join(&path, "center"),
+            )?;
+            let radius = ctx.positive(
+                ctx.required(&f, s.line, &path, "radius")?,
+                &join(&path, "radius"),
+            )?;
+            let sel = Selection::Ball { center, radius };
+            let held = sel.select(&mesh, &x0);
+            if held.is_empty() {
+                return Err(ctx.error(
+                    s.line,
+                    &path,
+                    "selects no vertex of the cloth (none within its radius of its center)",
+                ));
+            }
+            if let Some(j) = held_by_bars
+                .iter()
+                .position(|bar| bar.iter().any(|v| held.contains(v)))
+            {
+                return Err(ctx.error(
+                    s.line,
+                    &path,
+                    format!("holds vertices that handlebars[{j}] moves too"),
+                ));
+            }
+            pins.push(sel);
+        }
+    }
+
+    // obstacles and contact
+    let mut obstacles = Vec::new();
+    if let Some(n) = top.get("obstacles") {
+        for (i, o) in ctx.array(n, "obstacles")?.iter().enumerate() {
+            let path = format!("obstacles[{i}]");
+            let f = ctx.fields(o, &path, &[("mesh", Used), ("transform", Used)])?;
+            let mesh_node = ctx.required(&f, o.line, &path, "mesh")?;
+            let (rel, _) = ctx.resolve(mesh_node, &join(&path, "mesh"))?;
+            let transform = match f.get("transform") {
+                Some(t) => read_transform(ctx, t, &join(&path, "transform"))?,
+                None => Transform::default(),
+            };
+            obstacles.push(ObstacleSpec::Mesh {
+                path: rel,
+                transform,
+            });
+        }
+    }
+    let gravity = match top.get("gravity") {
+        Some(n) => ctx.numbers::<3>(n, "gravity")?,
+        None => [0.0; 3],
+    };
+    let friction = match top.get("obs_friction") {
+        Some(n) => ctx.non_negative(n, "obs_friction")?,
+        None => DEFAULT_OBS_FRICTION,
+    };
+    let contact_default = ContactSpec::default();
+    let (mut handle_stiffness, mut thickness) =
+        (DEFAULT_HANDLE_STIFFNESS, DEFAULT_REPULSION_THICKNESS);
+    if let Some(n) = top.get("magic") {
+        let collision = format!(
+            "the obstacle penalty here has its own stiffness (contact.stiffness = {:e} 1/(m s²), a cubic penalty per unit mass)",
+            contact_default.stiffness
+        );
+        let f = ctx.fields(
+            n,
+            "magic",
+            &[
+                ("handle_stiffness", Used),
+                ("repulsion_thickness", Used),
+                ("collision_stiffness", Ignored(&collision)),
+                (
+                    "relax_initial_state",
+                    Ignored("the initial state is simulated as given"),
+                ),
+            ],
+        )?;
+        if let Some(k) = f.get("handle_stiffness") {
+            handle_stiffness = ctx.positive(k, "magic.handle_stiffness")?;
+        }
+        if let Some(t) = f.get("repulsion_thickness") {
+            thickness = ctx.non_negative(t, "magic.repulsion_thickness")?;
+        }
+    }
+
+    Ok(Scene {
+        name: name.to_string(),
+        material,
+        mesh: MeshSpec::Obj {
+            path: mesh_rel,
+            transform,
+        },
+        placement: Placement::default(),
+        fabric_angle_deg: 0.0,
+        duration,
+        dt,
+        quasi_static: false,
+        gravity,
+        drag: 0.0,
+        damping,
+        wind,
+        handle_stiffness: Some(handle_stiffness),
+        model: ModelSpec {
+            only_1d,
+            ..ModelSpec::default()
+        },
+        psd: Psd::Psi,
+        solver: SolverSpec::default(),
+        pins,
+        handles,
+        obstacles,
+        contact: ContactSpec {
+            thickness,
+            friction,
+            ..contact_default
+        },
+        output: OutputSpec { obj_every: 1 },
+    })
+}
+
+/// A `transform`: `scale` (> 0), `translate` (3 numbers), `rotate` ([degrees, axis x, y, z]).
+fn read_transform(ctx: &mut Ctx, n: &Node, path: &str) -> Result<Transform, ShellError> {
+    let f = ctx.fields(
+        n,
+        path,
+        &[("scale", Used), ("translate", Used), ("rotate", Used)],
+    )?;
+    let mut t = Transform::default();
+    if let Some(s) = f.get("scale") {
+        t.scale = ctx.positive(s, &join(path, "scale"))?;
+    }
+    if let Some(v) = f.get("translate") {
+        t.translate = ctx.numbers::<3>(v, &join(path, "translate"))?;
+    }
+    if let Some(r) = f.get("rotate") {
+        t.rotate = ctx.numbers::<4>(r, &join(path, "rotate"))?;
+    }
+    Ok(t)
+}
+
+/// `cloths[0].materials`: the first material's `damping` (s, default 0); further materials are ignored.
+fn read_materials(ctx: &mut Ctx, n: &Node) -> Result<f64, ShellError> {
+    let key = "cloths[0].materials";
+    let mats = ctx.array(n, key)?;
+    let Some(m0) = mats.first() else {
+        return Err(ctx.error(n.line, key, "needs one material (for its damping)"));
+    };
+    let path = "cloths[0].materials[0]";
+    let f = ctx.fields(
+        m0,
+        path,
+        &[
+            ("damping", Used),
+            (
+                "data",
+                Ignored(
+                    "the ARCSim material: the internal forces come from the HYLC material alone",
+                ),
+            ),
+            (
+                "thicken",
+                Ignored("a factor of the ARCSim material, which the HYLC model does not use"),
+            ),
+        ],
+    )?;
+    let damping = match f.get("damping") {
+        Some(d) => ctx.non_negative(d, &join(path, "damping"))?,
+        None => 0.0,
+    };
+    for (i, m) in mats.iter().enumerate().skip(1) {
+        ctx.warn(
+            m.line,
+            &format!("{key}[{i}]"),
+            "ignored: the cloth has one material here (the HYLC material; damping from materials[0])",
+        );
+    }
+    Ok(damping)
+}
+
+/// `motions`: each a list of keyframes `{"time": t, "transform": {"translate": [..]}}` with increasing times; a
+/// rotation or scale other than the identity is an error (the handles here translate).
+fn read_motions(ctx: &mut Ctx, n: &Node) -> Result<Vec<Motion>, ShellError> {
+    let mut out = Vec::new();
+    for (i, m) in ctx.array(n, "motions")?.iter().enumerate() {
+        let path = format!("motions[{i}]");
+        let keys = ctx.array(m, &path)?;
+        if keys.is_empty() {
+            return Err(ctx.error(m.line, &path, "needs at least one keyframe"));
+        }
+        let mut motion: Motion = Vec::new();
+        for (j, k) in keys.iter().enumerate() {
+            let kp = format!("{path}[{j}]");
+            let f = ctx.fields(k, &kp, &[("time", Used), ("transform", Used)])?;
+            let tn = ctx.required(&f, k.line, &kp, "time")?;
+            let time = ctx.number(tn, &join(&kp, "time"))?;
+            if let Some(&(prev, _)) = motion.last() {
+                if time <= prev {
+                    return Err(ctx.error(
+                        tn.line,
+                        &join(&kp, "time"),
+                        format!("keyframe times must increase, got {time} after {prev}"),
+                    ));
+                }
+            }
+            let mut offset = [0.0; 3];
+            if let Some(t) = f.get("transform") {
+                let tp = join(&kp, "transform");
+                let tf = ctx.fields(
+                    t,
+                    &tp,
+                    &[("translate", Used), ("rotate", Used), ("scale", Used)],
+                )?;
+                if let Some(r) = tf.get("rotate") {
+                    let rk = join(&tp, "rotate");
+                    let rot = ctx.numbers::<4>(r, &rk)?;
+                    if rot[0] != 0.0 {
+                        return Err(ctx.error(
+                            r.line,
+                            &rk,
+                            "motions are translations here (a keyframe may not rotate)",
+                        ));
+                    }
+                }
+                if let Some(s) = tf.get("scale") {
+                    let sk = join(&tp, "scale");
+                    if ctx.number(s, &sk)? != 1.0 {
+                        return Err(ctx.error(
+                            s.line,
+                            &sk,
+                            "motions are translations here (a keyframe may not scale)",
+                        ));
+                    }
+                }
+                if let Some(v) = tf.get("translate") {
+                    offset = ctx.numbers::<3>(v, &join(&tp, "translate"))?;
+                }
+            }
+            motion.push((time, offset));
+        }
+        out.push(motion);
+    }
+    Ok(out)
+}
