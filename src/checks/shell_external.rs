@@ -358,7 +358,7 @@ impl Differentiable for FrictionCheck {
         let eps = 10f64.powf(rng.random_range(-7.0..-3.0));
         // tangential length on either side of ε, plus a normal part
         let y = eps
-            * if i % 2 == 0 {
+            * if i.is_multiple_of(2) {
                 rng.random_range(0.05..0.9)
             } else {
                 rng.random_range(1.1..3.0)

@@ -141,12 +141,15 @@ impl Mesh {
     }
 }
 
+/// A triangle surface: vertex positions and triangles (obstacles, pictures).
+pub type Surface = (Vec<[f64; 3]>, Vec<[usize; 3]>);
+
 /// An OBJ surface: positions, fan-triangulated faces, each face's `file:line`, each vertex's line.
 type ObjSurface = (Vec<[f64; 3]>, Vec<[usize; 3]>, Vec<String>, Vec<usize>);
 
 /// Read any OBJ triangle surface (`v` and `f` lines; polygons fan-triangulated) for an obstacle; errors name
 /// the file and line.
-pub fn load_obj_surface(path: &Path) -> Result<(Vec<[f64; 3]>, Vec<[usize; 3]>), ShellError> {
+pub fn load_obj_surface(path: &Path) -> Result<Surface, ShellError> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| ShellError::io(path, "cannot read the mesh", e))?;
     let (pos, tris, _, _) = parse_obj_surface(&text, &path.display().to_string())?;

@@ -297,7 +297,7 @@ impl Obstacle {
     }
 
     /// A triangle mesh of the surface for pictures (`None` for a plane).
-    pub fn surface(&self) -> Option<(Vec<[f64; 3]>, Vec<[usize; 3]>)> {
+    pub fn surface(&self) -> Option<super::mesh::Surface> {
         match self {
             Obstacle::Sphere { center, radius } => {
                 Some(super::render::sphere_mesh(*center, *radius, 48))

@@ -87,7 +87,7 @@ pub struct Outcome {
     pub positions: Vec<[f64; 3]>,
     pub triangles: Vec<[usize; 3]>,
     /// the obstacles' surfaces (spheres and meshes; planes have none), for pictures
-    pub obstacles: Vec<(Vec<[f64; 3]>, Vec<[usize; 3]>)>,
+    pub obstacles: Vec<crate::shell::mesh::Surface>,
 }
 
 /// Build and run a scene, writing the frames and the log to `out`; reports the scene as an [`Event::Print`]
