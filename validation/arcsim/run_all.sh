@@ -11,6 +11,7 @@
 #   FULL=1 validation/arcsim/run_all.sh                               # full length (end_time: 1 to 2.5 s)
 #   DURATION=0.2 validation/arcsim/run_all.sh 2D/stock_stretchX       # some scenes (<set>/<scene> or a regex)
 #   SUMMARY_ONLY=1 validation/arcsim/run_all.sh                       # only rebuild the table and plots
+#   RERUN=1 validation/arcsim/run_all.sh                              # rerun scenes already done (default: resume)
 #
 # Environment: HYLC (binary, default target/release/hylc), HYLC_SHARED (default ../shared), OUT (default
 # out/arcsim), DURATION (default 0.5), FULL=1 (the scenes' own end_time), SUMMARY_ONLY=1, RESULTS (the table,
@@ -39,7 +40,13 @@ if [ "${SUMMARY_ONLY:-0}" != 1 ]; then
     id="$set_name/$scene"
     if [ -n "$select_re" ] && ! [[ "$id" =~ ^($select_re)$ ]] && ! [[ "$id" =~ $select_re ]]; then continue; fi
     dir="$OUT/$id"
+    tag=$([ "$FULL" = 1 ] && echo full || echo "$DURATION")
+    # resumable: a scene finished with the same duration is kept unless RERUN=1
+    if [ "${RERUN:-0}" != 1 ] && [ -f "$dir/exit_code" ] && [ "$(cat "$dir/duration" 2>/dev/null)" = "$tag" ]; then
+      echo "== $id: done before (exit code $(cat "$dir/exit_code")), kept"; continue
+    fi
     rm -rf "$dir"; mkdir -p "$dir"
+    echo "$tag" > "$dir/duration"
     args=(simulate "$f" --quiet --out "$dir")
     if [ "$FULL" != 1 ]; then args+=(--duration "$DURATION"); fi
     if [ "$FULL" = 1 ]; then echo "== $id (full length)"; else echo "== $id (first $DURATION s)"; fi
