@@ -16,7 +16,7 @@ use std::process::Command;
 /// Grid vertices per side of the synthetic cloth (OBJ on [0, 1]², step 0.1; scaled by 2 in the scenes).
 const N: usize = 11;
 
-/// A folder laid out like ARCSim-HYLC's: `meshes/grid.obj`, `mats/m.json`, `tests/conf/<scene>.json` (the scene
+/// A folder laid out like ARCSim-HYLC's: `meshes/grid.obj` (the cloth), `meshes/tet.obj` (a closed obstacle), `mats/m.json`, `tests/conf/<scene>.json` (the scene
 /// names `meshes/...` and `mats/...` relative to the root, two folders above it).
 struct Fixture {
     root: PathBuf,
@@ -43,6 +43,12 @@ impl Fixture {
             }
         }
         std::fs::write(root.join("meshes/grid.obj"), obj).unwrap();
+        // a closed obstacle (a tetrahedron below the cloth)
+        std::fs::write(
+            root.join("meshes/tet.obj"),
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n",
+        )
+        .unwrap();
         default_material().save(&root.join("mats/m.json")).unwrap();
         Fixture { root }
     }
@@ -87,7 +93,7 @@ const FULL: &str = r#"{
     ]],
     "handlebars": [{BARS}],
     "handlespheres": [{"center": [-1, -1, 0.5], "radius": 0.25}],
-    "obstacles": [{"mesh": "meshes/grid.obj", "transform": {"scale": 0.5, "translate": [0, 0, -1]}}],
+    "obstacles": [{"mesh": "meshes/tet.obj", "transform": {"scale": 0.5, "translate": [0, 0, -1]}}],
     "gravity": [0, 0, -9.8],
     "obs_friction": 0.2,
     "magic": {"handle_stiffness": 5e4, "repulsion_thickness": 4e-3}
@@ -217,7 +223,7 @@ fn motions_handlespheres_and_every_honoured_key() {
     assert_eq!(
         s.obstacles,
         vec![ObstacleSpec::Mesh {
-            path: "../../meshes/grid.obj".into(),
+            path: "../../meshes/tet.obj".into(),
             transform: Transform {
                 scale: 0.5,
                 translate: [0.0, 0.0, -1.0],

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The built-in scenes with the original's basket1 (README, "Cloth results", "Scenes" table; issue 18 reran it
+# after the stretch strips moved to the original's handlebar geometry and steps became adaptive): each built-in
+# for 1 s at 1/60 s, PSD `psi` (and `full` for stretch-x); prints one table row per run from the run's log.
+#
+#   cargo build --release && validation/builtins/run.sh        # needs ../shared/data/hylc2020 (skips without it)
+set -uo pipefail
+cd "$(dirname "$0")/../.."
+HYLC=${HYLC:-target/release/hylc}
+M=${HYLC_SHARED:-../shared}/data/hylc2020/materials/basket1.json
+OUT=${OUT:-out/builtins}
+if [ ! -f "$M" ]; then echo "skipped: $M not found"; exit 0; fi
+echo "| scene | PSD | wall | Newton iterations | substeps (max per step) | steps not converged | at t = 1 s |"
+echo "| --- | --- | --- | --- | --- | --- | --- |"
+for run in stretch-x:psi stretch-x:full stretch-y:psi drape-x:psi drape-y:psi hanging:psi; do
+  scene=${run%%:*}; psd=${run##*:}
+  dir="$OUT/$scene-$psd"
+  "$HYLC" simulate "$scene" --material "$M" --psd "$psd" --quiet --out "$dir" > "$dir.txt" 2>&1 || true
+  python3 - "$dir/log.jsonl" "$scene" "$psd" <<'PY'
+import json, sys
+rs = [json.loads(l) for l in open(sys.argv[1])]
+last = rs[-1]
+forces = ", ".join(f"{n} ({f[0]:+.3f}, {f[1]:+.3f}, {f[2]:+.3f}) N" for n, f in last["handle_forces"])
+print(f"| `{sys.argv[2]}` | `{sys.argv[3]}` | {sum(r['wall'] for r in rs):.1f} s | {sum(r['newton'] for r in rs)} | "
+      f"{sum(r['substeps'] for r in rs)} ({max(r['substeps'] for r in rs)}) | {sum(not r['converged'] for r in rs)} | "
+      f"{forces or 'kinetic energy %.1e J' % last['energy_kinetic']} |")
+PY
+done
