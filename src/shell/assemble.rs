@@ -195,6 +195,9 @@ pub struct Assembled {
     pub zmax: [f64; 6],
     /// z of every triangle, in stencil order
     pub z: Vec<[f64; 6]>,
+    /// every stencil's local Hessian with the PSD option, in stencil order (only from [`assemble_keeping`];
+    /// rows and columns of absent flaps are zero)
+    pub local: Vec<[[f64; NDOF]; NDOF]>,
 }
 
 /// Elastic energy only; `None` if any triangle is degenerate.
@@ -216,6 +219,30 @@ pub fn assemble(
     hessian: bool,
     exact_too: bool,
 ) -> Option<Assembled> {
+    assemble_with(model, stencils, pattern, x, hessian, exact_too, false)
+}
+
+/// [`assemble`] with the Hessian, also keeping every stencil's local PSD-option Hessian in
+/// [`Assembled::local`] (the damping of the next step reuses those at the converged state).
+pub fn assemble_keeping(
+    model: &ElementModel,
+    stencils: &[Stencil],
+    pattern: &Pattern,
+    x: &[f64],
+    exact_too: bool,
+) -> Option<Assembled> {
+    assemble_with(model, stencils, pattern, x, true, exact_too, true)
+}
+
+fn assemble_with(
+    model: &ElementModel,
+    stencils: &[Stencil],
+    pattern: &Pattern,
+    x: &[f64],
+    hessian: bool,
+    exact_too: bool,
+    keep_local: bool,
+) -> Option<Assembled> {
     let exact_too = hessian && exact_too;
     if stencils.is_empty() {
         return Some(Assembled {
@@ -226,6 +253,7 @@ pub fn assemble(
             zmin: [0.0; 6],
             zmax: [0.0; 6],
             z: vec![],
+            local: vec![],
         });
     }
     let nthreads = rayon::current_num_threads().max(1);
@@ -243,6 +271,7 @@ pub fn assemble(
                 zmin: [f64::INFINITY; 6],
                 zmax: [f64::NEG_INFINITY; 6],
                 z: Vec::with_capacity(ss.len()),
+                local: Vec::with_capacity(if keep_local { ss.len() } else { 0 }),
             };
             let mut g = [0.0; NDOF];
             let mut h = [[0.0; NDOF]; NDOF];
@@ -258,6 +287,20 @@ pub fn assemble(
                 };
                 out.energy += e;
                 out.z.push(z);
+                if keep_local {
+                    let mut hl = h;
+                    for a in 3..6 {
+                        if !s.flaps[a - 3] || !model.bending {
+                            for r in 0..NDOF {
+                                for k in 0..3 {
+                                    hl[3 * a + k][r] = 0.0;
+                                    hl[r][3 * a + k] = 0.0;
+                                }
+                            }
+                        }
+                    }
+                    out.local.push(hl);
+                }
                 for k in 0..6 {
                     out.zmin[k] = out.zmin[k].min(z[k]);
                     out.zmax[k] = out.zmax[k].max(z[k]);
@@ -301,8 +344,17 @@ pub fn assemble(
         .collect();
     let mut parts: Vec<Assembled> = parts.into_iter().collect::<Option<Vec<_>>>()?;
     let z: Vec<[f64; 6]> = parts.iter().flat_map(|p| p.z.iter().copied()).collect();
+    let local: Vec<[[f64; NDOF]; NDOF]> = if keep_local {
+        parts
+            .iter_mut()
+            .flat_map(|p| std::mem::take(&mut p.local))
+            .collect()
+    } else {
+        vec![]
+    };
     let mut total = parts.swap_remove(0);
     total.z = z;
+    total.local = local;
     for p in &parts {
         total.energy += p.energy;
         total

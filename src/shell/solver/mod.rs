@@ -37,6 +37,7 @@ use super::dissipation::{self, Wind};
 use super::element::ElementModel;
 use super::mesh::Stencil;
 use super::obstacle::{self, Obstacle};
+use super::strain::NDOF;
 use super::ShellError;
 use faer::sparse::linalg::solvers::SymbolicLlt;
 use faer::Side;
@@ -254,6 +255,9 @@ pub struct Simulation {
     level: u32,
     /// converged substeps in a row at the current level
     streak: u32,
+    /// the local PSD Hessians at the state `.0` (the last converged assembly), which the next substep's damping
+    /// reuses instead of assembling them again
+    damping_cache: Option<(Vec<f64>, Vec<[[f64; NDOF]; NDOF]>)>,
 }
 
 /// Per-substep constants of the potential.
@@ -361,6 +365,7 @@ impl Simulation {
             steps: 0,
             level: 0,
             streak: 0,
+            damping_cache: None,
         })
     }
 
@@ -414,7 +419,9 @@ impl Simulation {
             let h = (dt / f64::from(1u32 << self.level)).min(t_end - self.time);
             match self.substep(h, step)? {
                 Substep::Done(done) => {
-                    let (m, tg) = *done;
+                    let (mut m, tg) = *done;
+                    let local = std::mem::take(&mut m.asm.local);
+                    self.damping_cache = (!local.is_empty()).then(|| (m.x.clone(), local));
                     newton += m.newton;
                     substeps += 1;
                     dt_min = dt_min.min(h);

@@ -3,7 +3,7 @@
 //! drag), with the data they freeze at the start of a substep.
 
 use super::{dissipation, non_finite_material, obstacle, Simulation, Target};
-use crate::shell::assemble::{assemble, gather, Assembled};
+use crate::shell::assemble::{assemble, assemble_keeping, gather, Assembled};
 use crate::shell::dissipation::DragFace;
 use crate::shell::element::ElementModel;
 use crate::shell::obstacle::FrictionContact;
@@ -40,7 +40,14 @@ impl Simulation {
         let dynamic = !s.quasi_static;
         let mut damping = Vec::new();
         let mut damping_values = Vec::new();
-        if dynamic && s.damping > 0.0 {
+        let cached = self
+            .damping_cache
+            .as_ref()
+            .filter(|(x, local)| x.as_slice() == xn && local.len() == self.stencils.len());
+        if dynamic && s.damping > 0.0 && cached.is_some() {
+            // the last converged assembly was at xₙ: its local PSD Hessians are the ones needed
+            damping = cached.map(|c| c.1.clone()).unwrap_or_default();
+        } else if dynamic && s.damping > 0.0 {
             // the dissipation must be convex: option (c) (exact Hessian) is replaced by option (b)
             let mut model: ElementModel = self.model.clone();
             if model.psd == Psd::None {
@@ -72,6 +79,8 @@ impl Simulation {
                     non_finite_material(&self.model, &self.stencils, xn, Some(step))
                         .unwrap_or(ShellError::Degenerate { step })
                 })?;
+        }
+        if !damping.is_empty() {
             damping_values = vec![0.0; self.pattern.nnz()];
             let coh = s.damping / h;
             for (si, (st, hm)) in self.stencils.iter().zip(&damping).enumerate() {
@@ -209,15 +218,28 @@ impl Simulation {
         x: &[f64],
         tg: &Target,
     ) -> Result<(Assembled, Vec<f64>), ShellError> {
-        let mut asm = assemble(
-            &self.model,
-            &self.stencils,
-            &self.pattern,
-            x,
-            true,
-            self.exact_first(),
-        )
-        .ok_or_else(|| {
+        let s = &self.settings;
+        // keep the local Hessians for the next substep's damping when they are the ones it needs
+        let keep = !s.quasi_static && s.damping > 0.0 && self.model.psd != Psd::None;
+        let asm = if keep {
+            assemble_keeping(
+                &self.model,
+                &self.stencils,
+                &self.pattern,
+                x,
+                self.exact_first(),
+            )
+        } else {
+            assemble(
+                &self.model,
+                &self.stencils,
+                &self.pattern,
+                x,
+                true,
+                self.exact_first(),
+            )
+        };
+        let mut asm = asm.ok_or_else(|| {
             let step = self.steps + 1;
             non_finite_material(&self.model, &self.stencils, x, Some(step))
                 .unwrap_or(ShellError::Degenerate { step })
