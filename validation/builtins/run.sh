@@ -10,6 +10,7 @@ HYLC=${HYLC:-target/release/hylc}
 M=${HYLC_SHARED:-../shared}/data/hylc2020/materials/basket1.json
 OUT=${OUT:-out/builtins}
 if [ ! -f "$M" ]; then echo "skipped: $M not found"; exit 0; fi
+mkdir -p "$OUT"
 echo "| scene | PSD | wall | Newton iterations | substeps (max per step) | steps not converged | at t = 1 s |"
 echo "| --- | --- | --- | --- | --- | --- | --- |"
 for run in stretch-x:psi stretch-x:full stretch-y:psi drape-x:psi drape-y:psi hanging:psi; do
