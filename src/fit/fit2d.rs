@@ -20,9 +20,13 @@
 //!    3 |secant| of each adjacent cell it agrees with, and set to 0 where it disagrees in sign (the minimum knot
 //!    exempt, as in FIT1D); along grid lines the bicubic is exactly these 1D Hermite cubics, so it is monotone
 //!    along every grid line outward from the minimum. Inside the patches monotonicity also depends on the twists
-//!    pˣʸ. Carlson & Fritsch (1985) give sufficient conditions; not having them, we check the sign of ∂f/∂u
-//!    (∂f/∂v) on a 7 × 7 grid of every patch not touching the minimum's column (row) and halve the four corner
-//!    twists of each failing patch, up to 40 rounds. A twist-free patch can still be non-monotone in u when pʸ
+//!    pˣʸ and on how the cross slopes vary. Carlson & Fritsch (1985) give sufficient conditions; not having them,
+//!    we check the sign of ∂f/∂u (∂f/∂v) on the whole of every patch not touching the minimum's column (row),
+//!    certified on the Bernstein–Bézier coefficients of the derivative with adaptive subdivision (a sample of
+//!    the patch is not enough: where a grid line's slope is ≈ 0 at one end of a cell and 3 × its secant at the
+//!    other, as Fritsch–Carlson allows, ∂f/∂u vanishes quadratically towards that edge along the rows while the
+//!    interior's cross terms vanish only linearly, so f can fall in a thin strip along the edge; a 7 × 7 sample
+//!    missed one with s > 0.84), and halve the four corner twists of each failing patch, up to 40 rounds. A twist-free patch can still be non-monotone in u when pʸ
 //!    varies strongly along u, so then (up to 60 rounds) the corners of each failing patch get pˣʸ = 0 and |pʸ|
 //!    (for a failure along u; |pˣ| along v) halved, never below pˣ_min and never changing sign, which keeps the
 //!    grid lines monotone; in the limit (all cross slopes ±pˣ_min) the offending term vanishes. Patches that
@@ -217,14 +221,58 @@ impl Grid {
         )
     }
 
-    /// Patches failing the interior monotonicity check of step 5 (sign of ∂f/∂u and ∂f/∂v away from the minimum).
+    /// The Bézier control net `b[a][b]` of patch `(ci, cj)` (a along u, b along v): on the patch the bicubic is
+    /// Σ b[a][b] B³_a(s) B³_b(t) with s, t ∈ [0, 1] the local coordinates and B³ the cubic Bernstein polynomials.
+    /// Per axis the Hermite data (p₀, p₁, h m₀, h m₁) of a cubic have the net (p₀, p₀ + h m₀/3, p₁ − h m₁/3, p₁);
+    /// the patch's net is the tensor product of that map applied to its 16 Hermite data.
+    fn bezier_net(&self, (ci, cj): (usize, usize)) -> [[f64; 4]; 4] {
+        const THIRD: f64 = 1.0 / 3.0;
+        // rows: net points; columns: weights of (p₀, p₁, h m₀, h m₁)
+        const M: [[f64; 4]; 4] = [
+            [1.0, 0.0, 0.0, 0.0],
+            [1.0, 0.0, THIRD, 0.0],
+            [0.0, 1.0, 0.0, -THIRD],
+            [0.0, 1.0, 0.0, 0.0],
+        ];
+        let (hu, hv) = (self.tu[ci + 1] - self.tu[ci], self.tv[cj + 1] - self.tv[cj]);
+        // g[k][l]: k over (p at ci, p at ci + 1, hu pˣ at ci, hu pˣ at ci + 1), l likewise along v
+        let mut g = [[0.0; 4]; 4];
+        for (k, row) in g.iter_mut().enumerate() {
+            for (l, gkl) in row.iter_mut().enumerate() {
+                let idx = self.at(ci + k % 2, cj + l % 2);
+                *gkl = match (k >= 2, l >= 2) {
+                    (false, false) => self.p[idx],
+                    (true, false) => hu * self.mu[idx],
+                    (false, true) => hv * self.mv[idx],
+                    (true, true) => hu * hv * self.muv[idx],
+                };
+            }
+        }
+        let mut net = [[0.0; 4]; 4];
+        for (a, row) in net.iter_mut().enumerate() {
+            for (b, nab) in row.iter_mut().enumerate() {
+                for k in 0..4 {
+                    for l in 0..4 {
+                        *nab += M[a][k] * g[k][l] * M[b][l];
+                    }
+                }
+            }
+        }
+        net
+    }
+
+    /// Patches failing the interior monotonicity check of step 5: the sign of ∂f/∂u (∂f/∂v) on the whole of every
+    /// patch not touching the minimum's column (row), certified by [`nonnegative`] on the Bernstein coefficients
+    /// of the derivative (not sampled: a sign change can hide between any finite set of samples, e.g. within
+    /// 1/20 of a patch from an edge where the grid line's slope is ≈ 0).
     fn failing_patches(&self, i_min: usize, j_min: usize) -> Vec<Failing> {
-        let s = self.spline();
         let scale = self
             .p
             .iter()
             .fold(0.0f64, |m, v| m.max(v.abs()))
             .max(1e-300);
+        // on ∂f/∂s = h_u ∂f/∂u (∂f/∂t = h_v ∂f/∂v): a drop of at most 1e-10 of the largest value across a patch
+        let tol = 1e-10 * scale;
         let (nu, nv) = (self.tu.len(), self.tv.len());
         let mut out = Vec::new();
         for cj in 0..nv - 1 {
@@ -236,19 +284,19 @@ impl Grid {
                 if !(check_x || check_y) {
                     continue;
                 }
-                let (hu, hv) = (self.tu[ci + 1] - self.tu[ci], self.tv[cj + 1] - self.tv[cj]);
-                let tol_u = 1e-10 * scale / hu;
-                let tol_v = 1e-10 * scale / hv;
-                let (mut fx, mut fy) = (false, false);
-                for a in 0..=6 {
-                    for b in 0..=6 {
-                        let u = self.tu[ci] + hu * a as f64 / 6.0;
-                        let v = self.tv[cj] + hv * b as f64 / 6.0;
-                        let d = s.eval2(u, v);
-                        fx |= check_x && sx * d[1] < -tol_u;
-                        fy |= check_y && sy * d[2] < -tol_v;
+                let net = self.bezier_net((ci, cj));
+                // Bernstein coefficients of the outward derivative, first index along the derivative
+                // (degree 2), second across it (degree 3)
+                let mut du = [[0.0; 4]; 3];
+                let mut dv = [[0.0; 4]; 3];
+                for a in 0..3 {
+                    for b in 0..4 {
+                        du[a][b] = sx * 3.0 * (net[a + 1][b] - net[a][b]);
+                        dv[a][b] = sy * 3.0 * (net[b][a + 1] - net[b][a]);
                     }
                 }
+                let fx = check_x && !nonnegative(&du, tol);
+                let fy = check_y && !nonnegative(&dv, tol);
                 if fx || fy {
                     out.push(Failing {
                         cell: (ci, cj),
@@ -260,6 +308,66 @@ impl Grid {
         }
         out
     }
+}
+
+/// De Casteljau at ½: the Bernstein coefficients of a polynomial on [0, 1] split into those on [0, ½] and [½, 1].
+fn split_half<const N: usize>(c: [f64; N]) -> ([f64; N], [f64; N]) {
+    let (mut lo, mut hi, mut w) = (c, c, c);
+    for r in 1..N {
+        for i in 0..N - r {
+            w[i] = 0.5 * (w[i] + w[i + 1]);
+        }
+        lo[r] = w[0];
+        hi[N - 1 - r] = w[N - 1 - r];
+    }
+    (lo, hi)
+}
+
+/// Subdivision depth and box budget of [`nonnegative`]: 2⁻¹² of a patch per side, at most 4096 subdivisions.
+const CERTIFY_DEPTH: u32 = 12;
+const CERTIFY_BOXES: usize = 4096;
+
+/// Whether the polynomial q(s, t) = Σ c[a][b] B²_a(s) B³_b(t) is ≥ −`tol` on the whole unit square, certified:
+/// a polynomial lies between the least and the largest of its Bernstein coefficients, so all of them ≥ −tol proves
+/// it; a corner coefficient is a value of q, so one below −tol disproves it; otherwise the square is split in four
+/// (de Casteljau), whose coefficients converge to q quadratically, down to [`CERTIFY_DEPTH`] levels and within
+/// [`CERTIFY_BOXES`] splits. Undecided boxes count as failing (q is then within rounding of −tol somewhere), so a
+/// `true` is a proof and step 5 repairs everything else.
+fn nonnegative(c: &[[f64; 4]; 3], tol: f64) -> bool {
+    fn go(c: &[[f64; 4]; 3], tol: f64, depth: u32, budget: &mut usize) -> bool {
+        if c.iter().flatten().all(|&x| x >= -tol) {
+            return true;
+        }
+        if [c[0][0], c[0][3], c[2][0], c[2][3]]
+            .iter()
+            .any(|&x| x < -tol)
+            || depth == 0
+            || *budget == 0
+        {
+            return false;
+        }
+        *budget -= 1;
+        let (mut lo, mut hi) = ([[0.0; 4]; 3], [[0.0; 4]; 3]);
+        for b in 0..4 {
+            let (l, h) = split_half([c[0][b], c[1][b], c[2][b]]);
+            for a in 0..3 {
+                lo[a][b] = l[a];
+                hi[a][b] = h[a];
+            }
+        }
+        for half in [lo, hi] {
+            let (mut l, mut h) = ([[0.0; 4]; 3], [[0.0; 4]; 3]);
+            for a in 0..3 {
+                (l[a], h[a]) = split_half(half[a]);
+            }
+            if !go(&l, tol, depth - 1, budget) || !go(&h, tol, depth - 1, budget) {
+                return false;
+            }
+        }
+        true
+    }
+    let mut budget = CERTIFY_BOXES;
+    go(c, tol, CERTIFY_DEPTH, &mut budget)
 }
 
 /// The minimum knot of step 3 (i_min along u, j_min along v) and the knot v = 0 (j0), about which step 6 takes
@@ -767,6 +875,139 @@ mod tests {
             fit.report
         );
         assert_eq!(fit.report.nonmonotone_patches, 0);
+    }
+
+    /// A grid of `nu` × `nv` knots from row-major (v outer) arrays.
+    fn grid(tu: &[f64], tv: &[f64], p: &[f64], mu: &[f64], mv: &[f64], muv: &[f64]) -> Grid {
+        Grid {
+            tu: tu.to_vec(),
+            tv: tv.to_vec(),
+            p: p.to_vec(),
+            mu: mu.to_vec(),
+            mv: mv.to_vec(),
+            muv: muv.to_vec(),
+        }
+    }
+
+    #[test]
+    fn bezier_net_and_its_derivative_coefficients_reproduce_the_spline() {
+        let (tu, tv) = ([-0.3, 0.1, 0.5], [0.0, 0.25, 0.7]);
+        let n = 9;
+        let w = |k: usize, a: f64, b: f64| {
+            (0..n)
+                .map(|i| a * ((i * k) as f64 * 0.7).sin() + b)
+                .collect::<Vec<_>>()
+        };
+        let g = grid(
+            &tu,
+            &tv,
+            &w(3, 1.0, 2.0),
+            &w(5, 0.8, 0.1),
+            &w(7, 0.6, -0.2),
+            &w(11, 2.0, 0.0),
+        );
+        let s = g.spline();
+        let bern = |n: usize, k: usize, x: f64| {
+            let binom = [
+                [1.0, 0.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0, 0.0],
+                [1.0, 2.0, 1.0, 0.0],
+                [1.0, 3.0, 3.0, 1.0],
+            ];
+            binom[n][k] * x.powi(k as i32) * (1.0 - x).powi((n - k) as i32)
+        };
+        for (ci, cj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+            let net = g.bezier_net((ci, cj));
+            let (hu, hv) = (tu[ci + 1] - tu[ci], tv[cj + 1] - tv[cj]);
+            for (a, b) in [(0.0, 0.0), (0.3, 0.8), (0.55, 0.1), (1.0, 0.45), (0.9, 1.0)] {
+                let (u, v) = (tu[ci] + a * hu, tv[cj] + b * hv);
+                let d = s.eval2(u, v);
+                let (mut f, mut fs, mut ft) = (0.0, 0.0, 0.0);
+                for i in 0..4 {
+                    for j in 0..4 {
+                        f += net[i][j] * bern(3, i, a) * bern(3, j, b);
+                    }
+                }
+                for i in 0..3 {
+                    for j in 0..4 {
+                        fs += 3.0 * (net[i + 1][j] - net[i][j]) * bern(2, i, a) * bern(3, j, b);
+                        ft += 3.0 * (net[j][i + 1] - net[j][i]) * bern(3, j, a) * bern(2, i, b);
+                    }
+                }
+                assert!((f - d[0]).abs() < 1e-12, "f at ({u}, {v}): {f} vs {}", d[0]);
+                assert!(
+                    (fs - hu * d[1]).abs() < 1e-12,
+                    "f_u at ({u}, {v}): {} vs {}",
+                    fs / hu,
+                    d[1]
+                );
+                assert!(
+                    (ft - hv * d[2]).abs() < 1e-12,
+                    "f_v at ({u}, {v}): {} vs {}",
+                    ft / hv,
+                    d[2]
+                );
+            }
+        }
+    }
+
+    /// Regression (proptest-regressions/fit2d.txt, case 20f84643…: "mid-row at 1.2476: not monotone at step
+    /// 360/400 of [0.135, 0.27]"): the patch of that fit in which f fell along u, with the minimum column moved to
+    /// u = 0 and the patch's lower row to v = 0 (values rounded to 5 digits). Its right edge has the slope
+    /// pˣ = pˣ_min, next to the Fritsch–Carlson cap pˣ = 3 × secant at the left, so along both rows ∂f/∂u ≈
+    /// 3 δ (1 − s)² vanishes quadratically towards the edge while the cross terms of the interior (pʸ rising along
+    /// u on both rows, the twist 1.98 at the lower left) vanish only linearly: ∂f/∂u < 0 in a strip s > 0.84, which
+    /// the former 7 × 7 sample check (s = 0, 1/6, …, 5/6, 1) missed. The certified check finds it and step 5
+    /// repairs it.
+    #[test]
+    fn a_sign_change_of_the_derivative_next_to_a_flat_edge_is_found_and_repaired() {
+        let mut g = grid(
+            &[0.0, 0.135, 0.27],
+            &[0.0, 0.19193527110105266],
+            &[1.56513, 1.78701, 1.82372, 1.71414, 2.13730, 2.18080],
+            &[1.51384, 0.81565, 0.00100, 2.63625, 0.96656, 0.00100],
+            &[0.75571, 1.58123, 1.60521, 0.79333, 2.08166, 2.12463],
+            &[4.90910, 1.97813, 0.0, 0.0, 0.0, 0.0],
+        );
+        let min = Minimum { i: 0, j: 0, j0: 0 };
+        let (hu, hv) = (0.135, 0.19193527110105266);
+        // the least ∂f/∂u on an (n + 1)² sample of the patch [0.135, 0.27] × [0, hv]
+        let least_fu = |g: &Grid, n: usize| {
+            let s = g.spline();
+            let mut m = f64::INFINITY;
+            for a in 0..=n {
+                for b in 0..=n {
+                    m = m.min(
+                        s.eval2(0.135 + hu * a as f64 / n as f64, hv * b as f64 / n as f64)[1],
+                    );
+                }
+            }
+            m
+        };
+        assert!(least_fu(&g, 6) > 0.0, "the 7 × 7 sample sees no failure");
+        let before = least_fu(&g, 400);
+        assert!(before < -1e-3, "yet ∂f/∂u reaches {before}");
+        let failing = g.failing_patches(min.i, min.j);
+        assert_eq!(failing.len(), 1);
+        assert_eq!(failing[0].cell, (1, 0));
+        assert!(failing[0].along_u && !failing[0].along_v);
+
+        let p = g.p.clone();
+        let rounds = g.monotone_patches(&min, 1e-3, true);
+        assert_eq!(rounds.nonmonotone, 0);
+        assert!(g.failing_patches(min.i, min.j).is_empty());
+        // two halvings of the corner twists suffice; values and slopes stay (C¹ by construction)
+        assert_eq!((rounds.twist, rounds.slope), (2, 0));
+        assert_eq!(g.p, p);
+        assert_eq!(g.muv[1], 1.97813 / 4.0);
+        let after = least_fu(&g, 400);
+        assert!(after >= 0.0, "∂f/∂u reaches {after} after the repair");
+        // the mid-row of the proptest, densely
+        let s = g.spline();
+        let row: Vec<f64> = (0..=400)
+            .map(|k| s.eval2(0.135 + hu * k as f64 / 400.0, 0.5 * hv)[0])
+            .collect();
+        assert!(row.windows(2).all(|w| w[1] >= w[0]));
     }
 
     #[test]
