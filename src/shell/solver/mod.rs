@@ -257,8 +257,11 @@ pub struct Simulation {
     streak: u32,
     /// the local PSD Hessians at the state `.0` (the last converged assembly), which the next substep's damping
     /// reuses instead of assembling them again
-    damping_cache: Option<(Vec<f64>, Vec<[[f64; NDOF]; NDOF]>)>,
+    damping_cache: Option<DampingCache>,
 }
+
+/// The state and the local PSD Hessians assembled there.
+type DampingCache = (Vec<f64>, Vec<[[f64; NDOF]; NDOF]>);
 
 /// Per-substep constants of the potential.
 struct Target {
