@@ -3,6 +3,7 @@
 
 use hylc::generate::default_pattern;
 use hylc::micro::envelope::{parameter_derivatives, strain_derivatives, PARAMETER_NAMES};
+use hylc::micro::sensitivity::YarnParameter;
 use hylc::micro::{MacroStrain, MicroProblem, SolverOptions, Status};
 use hylc::rod::YarnMaterial;
 
@@ -74,29 +75,15 @@ fn parameter_derivatives_match_resolves() {
     let psi0 = sol.psi().unwrap();
     let mut worst: f64 = 0.0;
     for (k, name) in PARAMETER_NAMES.iter().enumerate() {
-        let set = |m: &mut YarnMaterial, v: f64| match k {
-            0 => m.young = v,
-            1 => m.shear = v,
-            2 => m.bend_twist_factor = v,
-            3 => m.contact_stiffness = v,
-            _ => m.radius = v,
-        };
-        let get = |m: &YarnMaterial| {
-            [
-                m.young,
-                m.shear,
-                m.bend_twist_factor,
-                m.contact_stiffness,
-                p.pattern.radius,
-            ][k]
-        };
-        let v0 = get(&base);
+        let param = YarnParameter::ALL[k];
+        assert_eq!(param.name(), *name);
+        let v0 = param.get(&p.material);
         let h = 1e-4 * v0;
         let at = |v: f64| {
             let mut m = base.clone();
-            set(&mut m, v);
+            param.set(&mut m, v);
             let mut pat = p.pattern.clone();
-            if k == 4 {
+            if param == YarnParameter::Radius {
                 pat.radius = v;
             }
             let q = MicroProblem::new(pat, &m, p.options.clone());
@@ -113,7 +100,7 @@ fn parameter_derivatives_match_resolves() {
         );
         worst = worst.max(e);
     }
-    eprintln!("∂Ψ̄/∂(Y, G, γ, k_c, r) against re-solves: worst relative error {worst:.2e}");
+    eprintln!("∂Ψ̄/∂(Y, G, γ, k_c, f, r) against re-solves: worst relative error {worst:.2e}");
 }
 
 #[test]

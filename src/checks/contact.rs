@@ -102,6 +102,146 @@ impl Differentiable for PairCheck {
     }
 }
 
+/// The pair energy as a function of the 12 coordinates and the contact radius r (13 inputs): the fast side is
+/// the kernel's value, gradient and Hessian with the radius derivatives of
+/// [`PairKernel::radius_derivatives`] as the 13th gradient entry and the last Hessian row and column (the mixed
+/// derivative ∂(∇ₓE)/∂r of the equilibrium sensitivities, issue 22); the reference is the plain formula with r
+/// as a dual number. Scales as [`PairCheck`] (r is a length like the coordinates, so ∂E/∂r ~ V/r and the mixed
+/// and second radius derivatives ~ V/r²); samples are [`sample_pair`]'s at r = 1 mm, the radius input at r.
+pub struct PairRadiusCheck {
+    pub name: String,
+    pub stiffness: f64,
+    pub radius: f64,
+    pub order: usize,
+    pub rest: [f64; 2],
+}
+
+impl PairRadiusCheck {
+    fn kernel(&self, radius: f64) -> Result<PairKernel, crate::contact::ContactError> {
+        PairKernel::new(self.stiffness, radius, self.order)
+    }
+
+    /// min over node pairs of |‖d_pq‖ − 2r| at the sample's own radius.
+    fn gap_to_cutoff(&self, x: &[f64]) -> f64 {
+        let p = points(x);
+        let rule = crate::contact::GaussLegendre::new(self.order);
+        let cut = 2.0 * x[12];
+        let mut best = f64::INFINITY;
+        for &sp in rule.nodes() {
+            let xa = p[0].lerp(&p[1], sp);
+            for &sq in rule.nodes() {
+                let xb = p[2].lerp(&p[3], sq);
+                best = best.min(((xa - xb).norm() - cut).abs());
+            }
+        }
+        best
+    }
+}
+
+impl Differentiable for PairRadiusCheck {
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+    fn dim(&self) -> usize {
+        13
+    }
+    fn scales(&self) -> Scales {
+        let v = self.stiffness * self.rest[0] * self.rest[1];
+        let r = self.radius;
+        Scales {
+            value: v,
+            gradient: v / r,
+            hessian: v / (r * r),
+        }
+    }
+    fn input_scale(&self, _i: usize) -> f64 {
+        self.radius
+    }
+    fn reference<D: Real>(&self, x: &[D]) -> D {
+        // E = k_c l̄_a l̄_b Σ_p Σ_q w_p w_q f(‖x_a(s_p) − x_b(s_q)‖/(2r)), f(ρ) = 1/ρ² + ρ² − 2 for ρ < 1
+        let rule = crate::contact::GaussLegendre::new(self.order);
+        let radius = x[12].clone();
+        let point = |start: usize, s: f64| -> [D; 3] {
+            std::array::from_fn(|i| x[start + i].clone() * (1.0 - s) + x[start + 3 + i].clone() * s)
+        };
+        let mut sum = D::from(0.0);
+        for (&sp, &wp) in rule.nodes().iter().zip(rule.weights()) {
+            let xa = point(0, sp);
+            for (&sq, &wq) in rule.nodes().iter().zip(rule.weights()) {
+                let xb = point(6, sq);
+                let mut dist2 = D::from(0.0);
+                for i in 0..3 {
+                    let di = xa[i].clone() - xb[i].clone();
+                    dist2 += di.clone() * di;
+                }
+                let rho = dist2.sqrt() / (radius.clone() * 2.0);
+                if rho.re() < 1.0 {
+                    let rho2 = rho.clone() * rho;
+                    sum += (rho2.recip() + rho2 - 2.0) * (wp * wq);
+                }
+            }
+        }
+        sum * (self.stiffness * self.rest[0] * self.rest[1])
+    }
+    fn fast(&self, x: &[f64]) -> Vgh {
+        let p = points(x);
+        let both = self.kernel(x[12]).and_then(|k| {
+            Ok((
+                k.value_gradient_hessian(&p, self.rest[0], self.rest[1])?,
+                k.radius_derivatives(&p, self.rest[0], self.rest[1])?,
+            ))
+        });
+        match both {
+            Ok((v, r)) => {
+                let mut gradient = DVector::zeros(13);
+                gradient.rows_mut(0, 12).copy_from(&v.gradient);
+                gradient[12] = r.value;
+                let mut hessian = DMatrix::zeros(13, 13);
+                hessian.view_mut((0, 0), (12, 12)).copy_from(&v.hessian);
+                for i in 0..12 {
+                    hessian[(i, 12)] = r.gradient[i];
+                    hessian[(12, i)] = r.gradient[i];
+                }
+                hessian[(12, 12)] = r.second;
+                Vgh {
+                    value: v.value,
+                    gradient,
+                    hessian,
+                }
+            }
+            // an error is a failure of the row (never sampled on purpose): NaN makes the comparison fail
+            Err(_) => Vgh {
+                value: f64::NAN,
+                gradient: DVector::from_element(13, f64::NAN),
+                hessian: DMatrix::from_element(13, 13, f64::NAN),
+            },
+        }
+    }
+    fn fast_value(&self, x: &[f64]) -> f64 {
+        self.kernel(x[12])
+            .and_then(|k| k.value(&points(x), self.rest[0], self.rest[1]))
+            .unwrap_or(f64::NAN)
+    }
+    fn kink_distance_of(&self, x: &[f64], i: usize) -> f64 {
+        // a coordinate step h moves every ‖d_pq‖ by at most h; a radius step h moves the cut-off 2r by 2h
+        let d = self.gap_to_cutoff(x);
+        if i == 12 {
+            0.5 * d
+        } else {
+            d
+        }
+    }
+    fn kink_distance(&self, x: &[f64]) -> f64 {
+        0.5 * self.gap_to_cutoff(x)
+    }
+    fn sample(&self, rng: &mut ChaCha8Rng, i: usize) -> Vec<f64> {
+        let p = sample_pair(rng, i, self.radius, self.order);
+        let mut x: Vec<f64> = p.iter().flat_map(|v| [v.x, v.y, v.z]).collect();
+        x.push(self.radius);
+        x
+    }
+}
+
 /// Number of input categories of [`sample_pair`].
 pub const PAIR_CATEGORIES: usize = 8;
 
@@ -235,10 +375,11 @@ pub fn random_rotation(rng: &mut ChaCha8Rng) -> Matrix3<f64> {
 }
 
 /// The contact rows: the pair energy at the default order Q = 4 and at Q = 2, with the calibrated k_c = 60 J/m²,
-/// r = 1 mm and rest lengths 1.5 r and 2 r (typical contact segments).
+/// r = 1 mm and rest lengths 1.5 r and 2 r (typical contact segments); and the same energy with the radius as a
+/// 13th input at Q = 4 (the radius derivatives of the equilibrium sensitivities).
 pub fn diff_checks() -> Vec<Box<dyn Check>> {
     let r = 1e-3;
-    [4usize, 2]
+    let mut rows: Vec<Box<dyn Check>> = [4usize, 2]
         .into_iter()
         .map(|q| {
             Box::new(PairCheck {
@@ -247,5 +388,13 @@ pub fn diff_checks() -> Vec<Box<dyn Check>> {
                 rest: [1.5 * r, 2.0 * r],
             }) as Box<dyn Check>
         })
-        .collect()
+        .collect();
+    rows.push(Box::new(PairRadiusCheck {
+        name: "contact pair with radius [Q=4]".into(),
+        stiffness: 60.0,
+        radius: r,
+        order: 4,
+        rest: [1.5 * r, 2.0 * r],
+    }));
+    rows
 }

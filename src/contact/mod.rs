@@ -19,7 +19,7 @@ pub mod pair;
 pub use broad::{
     brute_force_candidates, tile_segments, BroadPhase, CandidatePair, Segment, SegmentTopology,
 };
-pub use pair::{pair_energy_reference, PairKernel, PairVgh};
+pub use pair::{pair_energy_reference, PairKernel, PairRadiusDerivatives, PairVgh};
 
 use nalgebra::Vector3;
 

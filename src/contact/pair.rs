@@ -213,6 +213,64 @@ impl PairKernel {
         Ok(self.stiffness * rest_a * rest_b * acc)
     }
 
+    /// The radius derivatives of E_ab at fixed points (issue 22: equilibrium sensitivities to the contact radius):
+    /// ∂E/∂r, the mixed derivative ∂(∇ₓE)/∂r (12 entries, points in the order of `x`) and ∂²E/∂r².
+    ///
+    /// Per term, with u = d²/(4r²), g(u) = (1 − u)²/u and the gradient β d, β = W g'(u)/(2r²) (module docs):
+    /// ∂u/∂r = −2u/r, so ∂g/∂r = 2(1 − u²)/(u r), ∂²g/∂r² = (6u + 2/u)/r² and ∂β/∂r = −W (1 + 1/u²)/r³; the
+    /// mixed derivative of point k is c_k (∂β/∂r) d. Terms beyond the cut-off are zero (∂β/∂r jumps there from
+    /// −2W/r³ to 0: the gradient is only C⁰ in r where a quadrature distance equals 2r).
+    pub fn radius_derivatives(
+        &self,
+        x: &[Vector3<f64>; 4],
+        rest_a: f64,
+        rest_b: f64,
+    ) -> Result<PairRadiusDerivatives, ContactError> {
+        check_rest(rest_a, rest_b)?;
+        let mut out = PairRadiusDerivatives {
+            value: 0.0,
+            gradient: SVector::zeros(),
+            second: 0.0,
+        };
+        if self.beyond_cutoff(x) {
+            return Ok(out);
+        }
+        let r = self.radius;
+        let inv4r2 = 0.25 / (r * r);
+        let (s, w) = (self.rule.nodes(), self.rule.weights());
+        let ea = x[1] - x[0];
+        let eb = x[3] - x[2];
+        let mut grad = [Vector3::<f64>::zeros(); 4];
+        for p in 0..s.len() {
+            let xa = x[0] + ea * s[p];
+            for q in 0..s.len() {
+                let d = xa - (x[2] + eb * s[q]);
+                let Some(u) = active_term(&d, inv4r2, p, q)? else {
+                    continue;
+                };
+                let wt = w[p] * w[q];
+                let iu = 1.0 / u;
+                out.value += wt * 2.0 * (1.0 - u * u) * iu / r;
+                out.second += wt * (6.0 * u + 2.0 * iu) / (r * r);
+                let gd = d * (-wt * (1.0 + iu * iu) / (r * r * r));
+                let t = s[q];
+                grad[0] += gd * (1.0 - s[p]);
+                grad[1] += gd * s[p];
+                grad[2] -= gd * (1.0 - t);
+                grad[3] -= gd * t;
+            }
+        }
+        let scale = self.stiffness * rest_a * rest_b;
+        out.value *= scale;
+        out.second *= scale;
+        for k in 0..4 {
+            for i in 0..3 {
+                out.gradient[3 * k + i] = scale * grad[k][i];
+            }
+        }
+        Ok(out)
+    }
+
     /// E_ab with its gradient and exact Hessian with respect to (x_a0, x_a1, x_b0, x_b1).
     pub fn value_gradient_hessian(
         &self,
@@ -327,6 +385,17 @@ impl PairKernel {
         };
         Ok(out)
     }
+}
+
+/// The radius derivatives of one pair energy ([`PairKernel::radius_derivatives`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairRadiusDerivatives {
+    /// ∂E/∂r (J/m).
+    pub value: f64,
+    /// ∂(∇ₓE)/∂r (N/m per coordinate of (x_a0, x_a1, x_b0, x_b1)).
+    pub gradient: SVector<f64, 12>,
+    /// ∂²E/∂r² (J/m²).
+    pub second: f64,
 }
 
 /// The reference twin of [`PairKernel::value`], generic over the scalar, written plainly as the formula:

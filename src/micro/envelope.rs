@@ -9,8 +9,8 @@
 //!
 //! Parameters: the rod energies are linear in Y (stretching, bending), G (twisting), γ (bending and twisting) and
 //! k_c (contact), so their derivatives are the energies of the same state with that parameter set to 1; the
-//! radius enters as r² (stretching), r⁴ (bending, twisting) and through the contact kernel
-//! ([`PairKernel::radius_derivative`]).
+//! radius enters as r² (stretching), r⁴ (bending, twisting) and through the contact kernel at the contact radius
+//! ρ = f r ([`PairKernel::radius_derivative`]), which is also how the contact radius factor f enters.
 
 use super::elimination::Elimination;
 use super::solver::{local, MicroError, MicroProblem, MicroState, Solution};
@@ -21,12 +21,14 @@ use crate::tile::{Terms, Tile, Want};
 use nalgebra::{Matrix3, Vector3};
 use num_dual::Dual64;
 
-/// The yarn parameters of [`parameter_derivatives`], in order.
-pub const PARAMETER_NAMES: [&str; 5] = [
+/// The yarn parameters of [`parameter_derivatives`], in order (those of
+/// [`YarnParameter::ALL`](super::sensitivity::YarnParameter::ALL)).
+pub const PARAMETER_NAMES: [&str; 6] = [
     "young",
     "shear",
     "bend_twist_factor",
     "contact_stiffness",
+    "contact_radius_factor",
     "radius",
 ];
 
@@ -101,11 +103,12 @@ pub fn strain_derivatives(
     Ok(d.map(|v| v.map(|v| v / area)))
 }
 
-/// ∂Ψ̄/∂(Y, G, γ, k_c, r) (J/m² per unit parameter) at a converged equilibrium.
+/// ∂Ψ̄/∂(Y, G, γ, k_c, f, r) (J/m² per unit parameter; f the contact radius factor) at a converged equilibrium.
+/// The constraints do not depend on the parameters, so these are also the total derivatives dΨ̄/dθ.
 pub fn parameter_derivatives(
     problem: &MicroProblem,
     sol: &Solution,
-) -> Result<[f64; 5], MicroError> {
+) -> Result<[f64; 6], MicroError> {
     sol.psi().map_err(|source| MicroError::NeedsEquilibrium {
         what: "parameter derivatives",
         source,
@@ -126,8 +129,12 @@ pub fn parameter_derivatives(
     let e1 = tile
         .evaluate(&state.frames, &state.y, Want::Value, &Terms::ALL)?
         .parts;
-    // radius: the contact kernel's own derivative
-    let kernel = PairKernel::new(m.contact_stiffness, p.radius, m.contact_quadrature)?;
+    // radii: the contact kernel's own derivative at the contact radius ρ = f r
+    let kernel = PairKernel::new(
+        m.contact_stiffness,
+        tile.contact_radius,
+        m.contact_quadrature,
+    )?;
     let y = &state.y;
     let mut dc_dr = 0.0;
     for pair in &tile.contacts {
@@ -139,14 +146,21 @@ pub fn parameter_derivatives(
         )?;
     }
     let e = &sol.energy;
-    let (yg, g, ga, r) = (m.young, m.shear, m.bend_twist_factor, p.radius);
+    let (yg, g, ga, r, f) = (
+        m.young,
+        m.shear,
+        m.bend_twist_factor,
+        p.radius,
+        m.contact_radius_factor,
+    );
     let area = sol.area;
     Ok([
         (e1.stretch + ga * e1.bend) / area,
         ga * e1.twist / area,
         (yg * e1.bend + g * e1.twist) / area,
         e1.contact / area,
-        (2.0 * e.stretch / r + 4.0 * (e.bend + e.twist) / r + dc_dr) / area,
+        r * dc_dr / area,
+        (2.0 * e.stretch / r + 4.0 * (e.bend + e.twist) / r + f * dc_dr) / area,
     ])
 }
 
@@ -184,9 +198,7 @@ pub fn strain_stiffness(
     state: &MicroState,
 ) -> Result<StrainStiffness, MicroError> {
     let p = &problem.pattern;
-    let n = p.len();
-    let nd = 4 * n;
-    let r = p.radius;
+    let nd = 4 * p.len();
     let area = p.periods[0] * p.periods[1];
     let components: Vec<usize> = match state.family {
         Family::BendY => vec![0, 1, 2, 4],
@@ -219,46 +231,16 @@ pub fn strain_stiffness(
     }
     let ezz = (&ezz + ezz.transpose()) * 0.5;
 
-    // the scaled Newton matrix at the equilibrium
-    let elim = Elimination::in_family(p, &state.strain, state.family);
-    let mut tile = problem.tile(&elim);
-    let x = tile.home_positions(&state.y);
-    tile.update_contacts(&x, problem.options.contact_margin * r)?;
-    let ev = tile.evaluate(&state.frames, &state.y, Want::Hessian, &Terms::ALL)?;
-    let scale = |i: usize| if i < 3 * n { 1.0 } else { 1.0 / r };
-    let lower: Vec<(usize, usize, f64)> = ev
-        .hessian
-        .expect("asked for")
-        .into_iter()
-        .filter(|&(i, j, _)| i >= j)
-        .map(|(i, j, v)| (i, j, v * scale(i) * scale(j)))
-        .collect();
-    let diag_max = lower
-        .iter()
-        .filter(|t| t.0 == t.1)
-        .fold(0.0f64, |m, t| m.max(t.2.abs()))
-        .max(problem.material.stretch_stiffness() / r);
-    let bs: Vec<Vec<f64>> = b
-        .iter()
-        .map(|v| v.iter().enumerate().map(|(i, x)| x * scale(i)).collect())
-        .collect();
-    let mut kkt = super::linear::KktSolver::default();
-    let delta = kkt
-        .solve_refined(nd, &lower, 1e-10 * diag_max, &bs, problem.constraints(), 3)
-        .map_err(MicroError::Linear)?;
-    // δ_k = −H_s⁻¹ S b_k: bᵀH⁻¹b = −(S b_i)·δ_j; dy/dz_k = S δ_k
+    // dy/dz_k = −H⁻¹ b_k with one factorisation; bᵀH⁻¹b = −b_i · dy_j
+    let dy = super::sensitivity::equilibrium_response(problem, state, &b)?;
     let mut hessian = nalgebra::DMatrix::zeros(k, k);
     for i in 0..k {
         for j in 0..k {
-            let bkb: f64 = -bs[i].iter().zip(&delta[j]).map(|(a, d)| a * d).sum::<f64>();
+            let bkb: f64 = -b[i].iter().zip(&dy[j]).map(|(a, d)| a * d).sum::<f64>();
             hessian[(i, j)] = (ezz[(i, j)] - bkb) / area;
         }
     }
     let hessian = (&hessian + hessian.transpose()) * 0.5;
-    let dy = delta
-        .into_iter()
-        .map(|d| d.iter().enumerate().map(|(i, x)| x * scale(i)).collect())
-        .collect();
     Ok(StrainStiffness {
         components,
         hessian,

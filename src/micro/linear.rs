@@ -230,6 +230,95 @@ impl KktSolver {
         }
         Ok(out)
     }
+
+    /// δ with H δ + Aᵀλ = −b, A δ = 0 for each b in `rhs_list` when H is positive definite only on the null space
+    /// of A (a constrained equilibrium whose constraints hold back a mode of negative curvature, e.g. a yarn that
+    /// would slide): projected preconditioned conjugate gradients on the null space, preconditioned with the
+    /// constrained solve of H + μI (μ from `mu`, grown ×10 until it factorises), until √(rᵀz) ≤ `tol` times its
+    /// start value. An error when a search direction has pᵀHp ≤ 0 (H is not positive definite on the null space)
+    /// or after `max_iter` iterations.
+    pub fn solve_projected(
+        &mut self,
+        mu: f64,
+        rhs_list: &[Vec<f64>],
+        a: &[Vec<f64>],
+        tol: f64,
+        max_iter: usize,
+    ) -> Result<Vec<Vec<f64>>, FactorError> {
+        let Some((pattern, symbolic)) = self.pattern.as_ref() else {
+            return Err(FactorError::Other("solve before set_matrix".into()));
+        };
+        let lower = &pattern.lower;
+        let n = lower.n;
+        let cols = a.len().max(1);
+        let buf = workspace(&mut self.scratch, symbolic, cols);
+        let mut mu = mu.max(f64::MIN_POSITIVE);
+        let mut tries = 0;
+        while factorize_shifted(symbolic, lower, &self.matrix, mu, &mut self.values, buf).is_err() {
+            mu *= 10.0;
+            tries += 1;
+            if tries > 40 {
+                return Err(FactorError::NotPositiveDefinite);
+            }
+        }
+        let llt = factorize_shifted(symbolic, lower, &self.matrix, mu, &mut self.values, buf)?;
+        let mut solver = ConstrainedSolve::new(llt, buf, n, a)?;
+        let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
+        let mut out = Vec::with_capacity(rhs_list.len());
+        for b in rhs_list {
+            let mut x = vec![0.0; n];
+            let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
+            // z = M_A⁻¹ r: M z + Aᵀλ = r, A z = 0 (apply returns the negative)
+            let prec = |solver: &mut ConstrainedSolve, r: &[f64]| -> Vec<f64> {
+                solver
+                    .apply(&[r])
+                    .pop()
+                    .expect("one column")
+                    .into_iter()
+                    .map(|v| -v)
+                    .collect()
+            };
+            let mut z = prec(&mut solver, &r);
+            let mut p = z.clone();
+            let mut rz = dot(&r, &z);
+            let rz0 = rz;
+            let mut converged = rz0 <= 0.0;
+            for _ in 0..max_iter {
+                if rz <= tol * tol * rz0 {
+                    converged = true;
+                    break;
+                }
+                let mut hp = vec![0.0; n];
+                lower.add_symmetric_product(&self.matrix, &p, &mut hp);
+                let php = dot(&p, &hp);
+                if php.is_nan() || php <= 0.0 {
+                    return Err(FactorError::NotPositiveDefinite);
+                }
+                let alpha = rz / php;
+                for i in 0..n {
+                    x[i] += alpha * p[i];
+                    r[i] -= alpha * hp[i];
+                }
+                z = prec(&mut solver, &r);
+                let rz_new = dot(&r, &z);
+                let beta = rz_new / rz;
+                for i in 0..n {
+                    p[i] = z[i] + beta * p[i];
+                }
+                rz = rz_new;
+            }
+            if !converged && rz > tol * tol * rz0 {
+                return Err(FactorError::Other(format!(
+                    "projected conjugate gradients did not reach {tol:.0e} in {max_iter} iterations"
+                )));
+            }
+            if x.iter().any(|v| !v.is_finite()) {
+                return Err(FactorError::NotPositiveDefinite);
+            }
+            out.push(x);
+        }
+        Ok(out)
+    }
 }
 
 /// The rows of a list of vectors as slices.
@@ -374,6 +463,53 @@ fn solve_columns(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// H indefinite in the full space but positive definite on the null space of A: the shifted factorisation
+    /// fails at μ = 0, and the projected conjugate gradients agree with a dense solve of the KKT matrix.
+    #[test]
+    fn projected_solve_matches_dense_for_an_indefinite_h() {
+        let n = 5;
+        // diag(−3, 2, 3, 4, 5) with a coupling; A = e₀ᵀ removes the negative direction
+        let mut h = DMatrix::from_diagonal(&DVector::from_vec(vec![-3.0, 2.0, 3.0, 4.0, 5.0]));
+        h[(1, 2)] = 0.5;
+        h[(2, 1)] = 0.5;
+        h[(0, 3)] = 1.0;
+        h[(3, 0)] = 1.0;
+        let lower: Vec<(usize, usize, f64)> = (0..n)
+            .flat_map(|j| (j..n).map(move |i| (i, j)))
+            .filter(|&(i, j)| h[(i, j)] != 0.0)
+            .map(|(i, j)| (i, j, h[(i, j)]))
+            .collect();
+        let a = vec![vec![1.0, 0.0, 0.0, 0.0, 0.0]];
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.9).cos()).collect();
+        let mut solver = KktSolver::default();
+        solver.set_matrix(n, &lower).unwrap();
+        assert_eq!(
+            solver.solve_shifted(0.0, std::slice::from_ref(&b), &a, 0),
+            Err(FactorError::NotPositiveDefinite)
+        );
+        let d = solver
+            .solve_projected(1e-10, std::slice::from_ref(&b), &a, 1e-14, 100)
+            .unwrap()
+            .pop()
+            .unwrap();
+        let mut k = DMatrix::zeros(n + 1, n + 1);
+        k.view_mut((0, 0), (n, n)).copy_from(&h);
+        for i in 0..n {
+            k[(n, i)] = a[0][i];
+            k[(i, n)] = a[0][i];
+        }
+        let rhs = DVector::from_fn(n + 1, |i, _| if i < n { -b[i] } else { 0.0 });
+        let x = k.lu().solve(&rhs).unwrap();
+        for i in 0..n {
+            assert!((x[i] - d[i]).abs() < 1e-12, "{i}: {} vs {}", x[i], d[i]);
+        }
+        // negative curvature on the null space is refused
+        let a_wrong = vec![vec![0.0, 0.0, 0.0, 0.0, 1.0]];
+        assert!(solver
+            .solve_projected(1e-10, std::slice::from_ref(&b), &a_wrong, 1e-14, 100)
+            .is_err());
+    }
 
     /// A small SPD system with one constraint row against a dense solve of the full KKT matrix.
     #[test]

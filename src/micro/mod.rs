@@ -3,12 +3,13 @@
 //! Data flow: a macro strain ([`strain`]) selects a closed-form surface map ([`surface`]); the kinematics
 //! ([`elimination`]) place every vertex copy affinely in the unknowns; the Newton solver ([`solver`]) with its
 //! constrained linear system ([`linear`]) finds the equilibrium; [`envelope`] turns it into Ψ̄ and its
-//! derivatives.
+//! derivatives; [`sensitivity`] gives the equilibrium's derivatives with respect to the yarn parameters.
 
 pub mod elimination;
 pub mod envelope;
 pub mod linear;
 pub mod reference;
+pub mod sensitivity;
 pub mod solver;
 pub mod strain;
 pub mod surface;

@@ -11,5 +11,5 @@ pub mod state;
 pub mod stretch;
 
 pub use bend_twist::{BendTwistParams, StencilFrames};
-pub use material::YarnMaterial;
+pub use material::{YarnFileError, YarnMaterial, MAX_CONTACT_QUADRATURE};
 pub use state::{raw_reference_twists, set_rest_to_current, RodState, RodTopology, StencilDofs};

@@ -143,9 +143,9 @@ pub struct RunSummary {
 /// solver options as JSON, as 16 hex digits.
 pub fn problem_hash(problem: &MicroProblem) -> String {
     let text = format!(
-        "{}\n{:?}\n{}",
+        "{}\n{}\n{}",
         problem.pattern.to_pyp_string(),
-        problem.material,
+        problem.material.hash_text(),
         serde_json::to_string(&problem.options).unwrap_or_default()
     );
     format!("{:016x}", fnv1a64(text.as_bytes()))

@@ -152,3 +152,42 @@ impl<'a> Tile<'a> {
         Ok(count)
     }
 }
+
+impl Tile<'_> {
+    /// ∂E_contact/∂ρ and ∂(∇_y E_contact)/∂ρ (tile dofs) at dofs `y`, with ρ the contact radius
+    /// ([`Tile::contact_radius`]) and k_c the material's: the pair kernels' radius derivatives
+    /// ([`PairKernel::radius_derivatives`]) summed over the contact pairs, the position blocks turned into the dof
+    /// frame as the gradient's are (issue 22: equilibrium sensitivities to the contact radius).
+    pub fn contact_radius_derivatives(
+        &self,
+        y: &[f64],
+    ) -> Result<(f64, DVector<f64>), ContactError> {
+        let m = &self.material;
+        let kernel = PairKernel::new(
+            m.contact_stiffness,
+            self.contact_radius,
+            m.contact_quadrature,
+        )?;
+        let mut grad = Some(DVector::zeros(self.ndof()));
+        let mut none = None;
+        let mut total = 0.0;
+        for pair in &self.contacts {
+            let pts = pair.points(self);
+            let x: [Vector3<f64>; 4] = pts.map(|(v, o)| self.position(y, v, o));
+            let la = self.pattern.edges[pair.a].rest_length;
+            let lb = self.pattern.edges[pair.b].rest_length;
+            let d = kernel.radius_derivatives(&x, la, lb)?;
+            if d.value == 0.0 && d.gradient.iter().all(|&v| v == 0.0) {
+                continue;
+            }
+            total += d.value;
+            let local = super::Local::<12> {
+                value: d.value,
+                g: d.gradient,
+                h: Default::default(),
+            };
+            self.scatter_positions(&pts, &[], &local, &mut grad, &mut none);
+        }
+        Ok((total, grad.expect("set above")))
+    }
+}

@@ -131,7 +131,7 @@ pub struct Tile<'a> {
     /// The per-vertex dof map (none: dofs are world positions).
     pub dof_map: Option<DofMap>,
     pub contacts: Vec<ContactPair>,
-    /// Radius of the contact distance 2r (the yarn radius unless a calibration varies it).
+    /// Radius of the contact distance 2r: the yarn radius times the material's contact radius factor.
     pub contact_radius: f64,
 }
 
@@ -147,6 +147,7 @@ impl<'a> Tile<'a> {
     pub fn new(pattern: &'a Pattern, material: &YarnMaterial) -> Self {
         let mut material = material.clone();
         material.radius = pattern.radius;
+        let contact_radius = pattern.radius * material.contact_radius_factor;
         Tile {
             pattern,
             material,
@@ -155,7 +156,7 @@ impl<'a> Tile<'a> {
             placement: TileTransforms::flat(pattern.periods),
             dof_map: None,
             contacts: Vec::new(),
-            contact_radius: pattern.radius,
+            contact_radius,
         }
     }
 

@@ -66,6 +66,7 @@ pub fn gradient_parts(
         contact_stiffness: 1.0,
         contact_quadrature: form.quadrature,
         contact_exclusion: form.exclusion,
+        contact_radius_factor: form.radius_factor,
     };
     let state = RodState::from_pattern(pattern);
     let mut tile = Tile::new(pattern, &unit);

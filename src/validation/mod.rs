@@ -4,6 +4,8 @@
 //! - [`conformance`]: ψ and the strain chain against the original code's oracle vectors (item 3a);
 //! - [`calibration`]: the yarn parameters that make the original reference patterns static equilibria (item 3b);
 //! - [`grid`]: our micro solver against the original solver's displacements on the 9×9×9 grid (item 3c);
+//! - [`identify`]: the yarn parameters from the original data by Levenberg–Marquardt with the solver's derivatives
+//!   (issue 22);
 //! - [`fuzz`]: mutated inputs of the five input formats through the parsers and evaluators (issue 17).
 //!
 //! Each reads `../shared` (the caller passes the folder or files) and returns numbers; the callers (`hylc
@@ -13,6 +15,7 @@ pub mod calibration;
 pub mod conformance;
 pub mod fuzz;
 pub mod grid;
+pub mod identify;
 
 use std::path::PathBuf;
 

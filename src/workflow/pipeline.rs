@@ -45,6 +45,8 @@ pub struct RunConfig {
     pub fresh: bool,
     /// The construction of `.pyp` patterns (generated kinds know theirs).
     pub construction: Option<Construction>,
+    /// The yarn parameters of every solve (reference state, sampling, held-out grid); `hylc run --yarn FILE`.
+    pub yarn: YarnMaterial,
 }
 
 impl Default for RunConfig {
@@ -61,6 +63,7 @@ impl Default for RunConfig {
             dt: 1.0 / 60.0,
             fresh: false,
             construction: None,
+            yarn: YarnMaterial::default(),
         }
     }
 }
@@ -252,7 +255,15 @@ fn run_pattern(args: &RunConfig, arg: &str, log: &mut Log) -> Result<PatternRun,
 
     let t = Instant::now();
     let construction = construction_of(arg, args.construction)?;
-    let reference = stage_reference(&name, &dir, &pattern, &pattern_hash, construction, log)?;
+    let reference = stage_reference(
+        &name,
+        &dir,
+        &pattern,
+        &pattern_hash,
+        construction,
+        &args.yarn,
+        log,
+    )?;
     stages.push(("reference", t.elapsed().as_secs_f64()));
 
     let t = Instant::now();
@@ -306,22 +317,29 @@ fn stage_pattern(arg: &str, dir: &Path, log: &mut Log) -> Result<(Pattern, Strin
     Ok((pattern, pattern_hash))
 }
 
-/// Stage 2, the reference state (C1) in `reference.pyp`, reused when the pattern is unchanged; returns the
-/// contents of `reference.json` (pattern hash, construction, report).
+/// Stage 2, the reference state (C1) in `reference.pyp`, reused when the pattern and the yarn parameters are
+/// unchanged (a `reference.json` from before yarn files counts as made with the default yarn); returns the
+/// contents of `reference.json` (pattern hash, construction, yarn, report).
 fn stage_reference(
     name: &str,
     dir: &Path,
     pattern: &Pattern,
     pattern_hash: &str,
     construction: Construction,
+    yarn: &YarnMaterial,
     log: &mut Log,
 ) -> Result<serde_json::Value, WorkflowError> {
+    let yarn_json = serde_json::to_value(yarn).expect("yarn parameters serialise");
     let ref_path = dir.join("reference.pyp");
     let ref_json = dir.join("reference.json");
     let reused = std::fs::read_to_string(&ref_json)
         .ok()
         .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-        .filter(|v| v["pattern hash"] == pattern_hash && ref_path.exists());
+        .filter(|v| v["pattern hash"] == pattern_hash && ref_path.exists())
+        .filter(|v| match v.get("yarn") {
+            Some(recorded) => *recorded == yarn_json,
+            None => *yarn == YarnMaterial::default(),
+        });
     if let Some(v) = reused {
         log.line(&format!(
             "reference: reused {} (pattern unchanged)",
@@ -331,7 +349,7 @@ fn stage_reference(
     }
     let (q, report) = reference_state(
         pattern,
-        &YarnMaterial::default(),
+        yarn,
         construction,
         &SolverOptions::default(),
         &ReferenceOptions::default(),
@@ -342,7 +360,7 @@ fn stage_reference(
     })?;
     q.save_pyp(&ref_path)?;
     let v = json!({"pattern hash": pattern_hash, "construction": format!("{construction:?}"),
-                   "report": report});
+                   "yarn": yarn_json, "report": report});
     write_file(
         &ref_json,
         serde_json::to_string_pretty(&v).expect("JSON values serialise") + "\n",
@@ -372,7 +390,7 @@ fn stage_sample(args: &RunConfig, dir: &Path, log: &mut Log) -> Result<Sampled, 
     let t = Instant::now();
     let ref_path = dir.join("reference.pyp");
     let (q, _) = Pattern::load_pyp(&ref_path)?;
-    let problem = MicroProblem::new(q, &YarnMaterial::default(), SolverOptions::default());
+    let problem = MicroProblem::new(q, &args.yarn, SolverOptions::default());
     let plan = load_plan(&args.plan)?;
     let samples = dir.join("samples.jsonl");
     let ref_arg = ref_path.display().to_string();

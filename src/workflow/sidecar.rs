@@ -4,6 +4,7 @@
 
 use super::{write_file, WorkflowError};
 use crate::micro::MicroProblem;
+use crate::rod::YarnMaterial;
 use crate::sample::plan::fnv1a64;
 use crate::sample::run::problem_hash;
 use crate::sample::Plan;
@@ -29,11 +30,7 @@ pub fn write_meta(
         "problem": problem_hash(problem),
         "plan": plan,
         "density": problem.pattern.areal_density(m.density),
-        "yarn": {
-            "young": m.young, "shear": m.shear, "bend_twist_factor": m.bend_twist_factor, "radius": m.radius,
-            "density": m.density, "contact_stiffness": m.contact_stiffness,
-            "contact_quadrature": m.contact_quadrature, "contact_exclusion": m.contact_exclusion,
-        },
+        "yarn": m,
         "solver": problem.options,
         "periods": problem.pattern.periods,
         "pyp": pyp,
@@ -60,4 +57,24 @@ pub fn read_meta(
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
         Err(e) => Err(WorkflowError::io(&path, "cannot read", e)),
     }
+}
+
+/// The yarn parameters a sidecar records (`"yarn"`), `None` when it records none. Sidecars written before the
+/// contact radius factor existed lack that key; their contact distance was 2r, so it reads as 1. Any other
+/// missing or unknown key is an error naming the sidecar and the key.
+pub fn recorded_yarn(
+    samples: &Path,
+    meta: &serde_json::Map<String, serde_json::Value>,
+) -> Result<Option<YarnMaterial>, WorkflowError> {
+    let Some(v) = meta.get("yarn") else {
+        return Ok(None);
+    };
+    let mut v = v.clone();
+    if let serde_json::Value::Object(m) = &mut v {
+        m.entry("contact_radius_factor")
+            .or_insert(serde_json::json!(1.0));
+    }
+    YarnMaterial::from_json_str(&v.to_string(), &meta_path(samples))
+        .map(Some)
+        .map_err(|e| WorkflowError::Input(format!("{e} (in \"yarn\")")))
 }

@@ -3,6 +3,7 @@
 use clap::ValueEnum;
 use hylc::micro::reference::Construction;
 use hylc::micro::SolverOptions;
+use hylc::rod::YarnMaterial;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -28,6 +29,27 @@ impl SolverArgs {
             max_steps: self.max_steps,
             time_limit: self.time_limit,
             ..Default::default()
+        }
+    }
+}
+
+/// The yarn parameters of every command that solves (`solve`, `reference`, `sample`, `micro-grid`, `run`,
+/// `sensitivity`, `identify`): a yarn JSON file (`hylc yarn` prints the default one), or the defaults.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct YarnArgs {
+    /// yarn parameters as JSON (every key required; `hylc yarn` prints the defaults)
+    #[arg(long, value_name = "FILE")]
+    pub yarn: Option<PathBuf>,
+}
+
+impl YarnArgs {
+    /// The yarn file's parameters, or the defaults without `--yarn`.
+    pub fn material(&self) -> anyhow::Result<YarnMaterial> {
+        match &self.yarn {
+            None => Ok(YarnMaterial::default()),
+            Some(path) => {
+                Ok(YarnMaterial::load_json(path).map_err(|e| anyhow::anyhow!("--yarn {e}"))?)
+            }
         }
     }
 }

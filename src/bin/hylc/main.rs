@@ -8,6 +8,7 @@ mod check_derivatives;
 mod fit;
 mod fuzz;
 mod generate;
+mod identify;
 mod material;
 mod merge;
 mod micro_grid;
@@ -23,6 +24,7 @@ mod simulate;
 mod solve;
 mod strain;
 mod validate;
+mod yarn;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -52,8 +54,10 @@ enum Command {
     Sensitivity(sensitivity::Args),
     MicroGrid(micro_grid::Args),
     Calibrate(calibrate::Args),
+    Identify(identify::Args),
     Fuzz(fuzz::Args),
     Simulate(simulate::Args),
+    Yarn(yarn::Args),
 }
 
 /// The command line, or exit: help and version are printed as clap prints them, a usage error as one line
@@ -103,8 +107,10 @@ fn main() -> ExitCode {
         Command::Sensitivity(a) => sensitivity::run(a),
         Command::MicroGrid(a) => micro_grid::run(a),
         Command::Calibrate(a) => calibrate::run(a),
+        Command::Identify(a) => identify::run(a),
         Command::Fuzz(a) => fuzz::run_cmd(a),
         Command::Simulate(a) => simulate::run(a),
+        Command::Yarn(a) => yarn::run(a),
     };
     match result {
         Ok(code) => code,

@@ -1,7 +1,7 @@
 //! `hylc micro-grid`: our micro solver against the original solver's displacements on the 9×9×9 in-plane grid
 //! (`../shared/design/06-verification.md`, item 3c; `hylc::validation::grid`).
 
-use crate::args::{exit, SolverArgs};
+use crate::args::{exit, SolverArgs, YarnArgs};
 use crate::strain::load_pattern_noted;
 use anyhow::anyhow;
 use hylc::micro::{MicroProblem, SolverOptions};
@@ -31,6 +31,8 @@ pub struct Args {
     cold_every: usize,
     #[command(flatten)]
     solver: SolverArgs,
+    #[command(flatten)]
+    yarn: YarnArgs,
     /// no per-yarn slide constraints
     #[arg(long)]
     no_slide_constraints: bool,
@@ -46,29 +48,50 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         slide_constraints: !a.no_slide_constraints,
         ..a.solver.options()
     };
-    let ok = grid(
-        &a.pattern,
-        &a.data_dir,
-        a.json.as_deref(),
-        a.limit,
-        a.cold_every,
-        a.file_periods,
+    let ok = grid(&GridJob {
+        pattern: &a.pattern,
+        data_dir: &a.data_dir,
+        json: a.json.as_deref(),
+        limit: a.limit,
+        cold_every: a.cold_every,
+        file_periods: a.file_periods,
         options,
-    )?;
+        yarn: a.yarn.material()?,
+    })?;
     Ok(exit(ok, 3))
+}
+
+/// One grid run of [`grid`]: the flags of `hylc micro-grid`.
+pub struct GridJob<'a> {
+    /// The original pattern's `.pyp` file.
+    pub pattern: &'a str,
+    /// The displacement folder.
+    pub data_dir: &'a Path,
+    /// Where to write the summary as JSON.
+    pub json: Option<&'a Path>,
+    /// Solve only the first N points of the continuation order.
+    pub limit: Option<usize>,
+    /// Also solve every N-th point cold (0: none).
+    pub cold_every: usize,
+    /// Keep the file's periods.
+    pub file_periods: bool,
+    pub options: SolverOptions,
+    pub yarn: YarnMaterial,
 }
 
 /// Run the grid of one pattern, print the summary, optionally write it as JSON. `Ok(true)` when every
 /// continuation point converged.
-pub fn grid(
-    pattern: &str,
-    data_dir: &Path,
-    json: Option<&Path>,
-    limit: Option<usize>,
-    cold_every: usize,
-    file_periods: bool,
-    options: SolverOptions,
-) -> anyhow::Result<bool> {
+pub fn grid(job: &GridJob) -> anyhow::Result<bool> {
+    let GridJob {
+        pattern,
+        data_dir,
+        json,
+        limit,
+        cold_every,
+        file_periods,
+        ref options,
+        ref yarn,
+    } = *job;
     let p = if file_periods {
         // the periods as written, even where they disagree with the rest lengths (a diagnostic for basket)
         hylc::pattern::Pattern::load_pyp(pattern)?.0
@@ -78,7 +101,7 @@ pub fn grid(
     let data = GridData::load(data_dir)?;
     data.check_pattern(&p)
         .map_err(|e| anyhow!("{pattern} with {}: {e}", data_dir.display()))?;
-    let problem = MicroProblem::new(p, &YarnMaterial::default(), options);
+    let problem = MicroProblem::new(p, yarn, options.clone());
     let planned = limit.unwrap_or(GRID_LEN).min(GRID_LEN)
         + if cold_every == 0 {
             0
@@ -101,7 +124,7 @@ pub fn grid(
             path,
             pattern,
             data_dir,
-            &problem.options,
+            &problem,
             limit,
             file_periods,
             &summary,
@@ -112,18 +135,19 @@ pub fn grid(
 }
 
 /// Add (or replace) this run's entry in the JSON file `path`: an object {"about": …, "runs": {key: …}} keyed by
-/// the pattern's file stem, with " (no slide constraints)" appended when they are off and " (first N points)" for
-/// a partial run, so that several
+/// the pattern's file stem, with " (no slide constraints)" appended when they are off, " (yarn HASH)" for yarn
+/// parameters other than the defaults and " (first N points)" for a partial run, so that several
 /// `micro-grid` runs collect into one file. An existing file that is not such an object is left alone (error).
 fn write_json(
     path: &Path,
     pattern: &str,
     data_dir: &Path,
-    options: &SolverOptions,
+    problem: &MicroProblem,
     limit: Option<usize>,
     file_periods: bool,
     summary: &GridSummary,
 ) -> anyhow::Result<()> {
+    let options = &problem.options;
     let mut root = if path.exists() {
         let text = std::fs::read_to_string(path).map_err(|e| anyhow!("{}: {e}", path.display()))?;
         let v: serde_json::Value = serde_json::from_str(&text)
@@ -153,6 +177,15 @@ fn write_json(
     if file_periods {
         key.push_str(" (file periods)");
     }
+    let default_yarn = YarnMaterial {
+        radius: problem.material.radius,
+        ..YarnMaterial::default()
+    };
+    if problem.material != default_yarn {
+        // another yarn is another run: keyed by the hash of its parameters
+        let hash = hylc::sample::plan::fnv1a64(problem.material.hash_text().as_bytes());
+        key.push_str(&format!(" (yarn {hash:016x})"));
+    }
     if let Some(n) = limit.filter(|&n| n < GRID_LEN) {
         key.push_str(&format!(" (first {n} points)"));
     }
@@ -160,6 +193,7 @@ fn write_json(
         "pattern": Path::new(pattern).file_name().map(|s| s.to_string_lossy().into_owned()),
         "data": data_dir.file_name().map(|s| s.to_string_lossy().into_owned()),
         "options": options,
+        "yarn": problem.material,
         "summary": summary,
     });
     let text = serde_json::to_string_pretty(&root)?;

@@ -1,12 +1,11 @@
 //! `hylc reference PATTERN --out REF.pyp`: Algorithm C1 on a pattern (`03-homogenization.md`, section 6;
 //! `hylc::micro::reference`), written as `.pyp`.
 
-use crate::args::{ConstructionArg, OutputArgs};
+use crate::args::{ConstructionArg, OutputArgs, YarnArgs};
 use crate::strain::load_pattern_noted;
 use anyhow::anyhow;
 use hylc::micro::reference::{reference_state, Construction, ReferenceOptions};
 use hylc::micro::SolverOptions;
-use hylc::rod::YarnMaterial;
 use hylc::workflow::inputs::construction_of;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -29,10 +28,13 @@ pub struct Args {
     out: PathBuf,
     #[command(flatten)]
     output: OutputArgs,
+    #[command(flatten)]
+    yarn: YarnArgs,
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let (pattern, equilibrate_only, out) = (a.pattern.as_str(), a.equilibrate_only, &a.out);
+    let yarn = a.yarn.material()?;
     let p = load_pattern_noted(pattern)?;
     let construction = match a.construction {
         None if equilibrate_only => Construction::Woven,
@@ -40,7 +42,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     };
     let (q, report) = reference_state(
         &p,
-        &YarnMaterial::default(),
+        &yarn,
         construction,
         &SolverOptions::default(),
         &ReferenceOptions {

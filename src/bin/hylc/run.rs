@@ -1,7 +1,7 @@
 //! `hylc run`: the main job end to end (`hylc::workflow::pipeline`), printed as it goes, with a progress bar for
 //! the drape.
 
-use crate::args::ConstructionArg;
+use crate::args::{ConstructionArg, YarnArgs};
 use crate::printer::Printer;
 use hylc::workflow::pipeline::{self, RunConfig};
 use hylc::workflow::simulate::diverged;
@@ -43,6 +43,8 @@ pub struct Args {
     /// delete the output folder first instead of resuming
     #[arg(long)]
     fresh: bool,
+    #[command(flatten)]
+    yarn: YarnArgs,
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
@@ -56,6 +58,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         dt: a.dt,
         fresh: a.fresh,
         construction: a.construction.map(Into::into),
+        yarn: a.yarn.material()?,
     };
     let mut printer = Printer::default();
     match pipeline::run(&config, &mut |e| printer.show(e)) {

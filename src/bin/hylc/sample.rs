@@ -1,11 +1,10 @@
 //! `hylc sample PATTERN --plan P --out S.jsonl`: a sampling plan on one pattern
 //! (`04-sampling-fitting.md`, section "Sampling plan (C4)"; `hylc::sample`).
 
-use crate::args::{exit, SolverArgs};
+use crate::args::{exit, SolverArgs, YarnArgs};
 use crate::printer::sample_bar;
 use crate::strain::load_pattern_noted;
 use hylc::micro::MicroProblem;
-use hylc::rod::YarnMaterial;
 use hylc::sample::{parse_shard, run_plan_with, RunOptions};
 use hylc::workflow::inputs::load_plan;
 use hylc::workflow::sidecar::write_meta;
@@ -36,6 +35,8 @@ pub struct Args {
     limit: Option<usize>,
     #[command(flatten)]
     solver: SolverArgs,
+    #[command(flatten)]
+    yarn: YarnArgs,
 }
 
 /// `hylc sample`: exit code 3 when a written sample did not converge.
@@ -43,8 +44,9 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let (pattern, out, cold, limit) = (a.pattern.as_str(), a.out.as_path(), a.cold, a.limit);
     let plan = load_plan(&a.plan)?;
     let shard = a.shard.as_deref().map(parse_shard).transpose()?;
+    let yarn = a.yarn.material()?;
     let p = load_pattern_noted(pattern)?;
-    let problem = MicroProblem::new(p, &YarnMaterial::default(), a.solver.options());
+    let problem = MicroProblem::new(p, &yarn, a.solver.options());
     write_meta(out, pattern, &plan, &problem)?;
     let opts = RunOptions { cold, shard, limit };
     let bar = OnceLock::new();

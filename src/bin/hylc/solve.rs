@@ -1,13 +1,12 @@
 //! `hylc solve PATTERN --z …`: the micro solver on one pattern at one or more strains (`03-homogenization.md`;
 //! `hylc::micro`).
 
-use crate::args::{exit, SolverArgs};
+use crate::args::{exit, SolverArgs, YarnArgs};
 use crate::strain::{load_pattern_noted, parse_strain};
 use anyhow::anyhow;
 use hylc::micro::envelope::strain_derivatives;
 use hylc::micro::solver::world_positions;
 use hylc::micro::{MacroStrain, MicroProblem, Solution, SolverOptions};
-use hylc::rod::YarnMaterial;
 use hylc::strain::StrainComponent;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -30,6 +29,8 @@ pub struct Args {
     no_predictor: bool,
     #[command(flatten)]
     solver: SolverArgs,
+    #[command(flatten)]
+    yarn: YarnArgs,
     /// displacement limit factor (times r λ_min(I))
     #[arg(long, default_value_t = 1.0)]
     step_factor: f64,
@@ -48,7 +49,7 @@ pub struct Args {
     /// print one line per Newton step to stderr
     #[arg(long)]
     trace: bool,
-    /// Gauss points per segment of the contact quadrature (default: the calibrated yarn's)
+    /// Gauss points per segment of the contact quadrature (default: the yarn's)
     #[arg(long)]
     quadrature: Option<usize>,
 }
@@ -73,7 +74,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     };
     let (cold, predictor, json_out) = (a.cold, !a.no_predictor, a.json);
     let p = load_pattern_noted(&a.pattern)?;
-    let mut yarn = YarnMaterial::default();
+    let mut yarn = a.yarn.material()?;
     if let Some(q) = a.quadrature {
         if q == 0 {
             anyhow::bail!("--quadrature: expected at least 1 point per segment");

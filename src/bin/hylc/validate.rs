@@ -204,15 +204,16 @@ fn item_c(
             max_steps: 2000,
             ..Default::default()
         };
-        crate::micro_grid::grid(
-            &pattern.display().to_string(),
-            &data,
-            Some(&json),
-            grid_limit,
-            0,
-            false,
+        crate::micro_grid::grid(&crate::micro_grid::GridJob {
+            pattern: &pattern.display().to_string(),
+            data_dir: &data,
+            json: Some(&json),
+            limit: grid_limit,
+            cold_every: 0,
+            file_periods: false,
             options,
-        )?;
+            yarn: hylc::rod::YarnMaterial::default(),
+        })?;
         let v = read_json(&json)?;
         let s = v["runs"]
             .as_object()

@@ -209,6 +209,36 @@ impl GridData {
         })
     }
 
+    /// Grid data from values in the layout of `data.npy` (row g + 729 v holds vertex v at grid point g), e.g. a
+    /// synthetic field for tests; the same shape and finiteness checks as [`GridData::load`], `name` in errors.
+    pub fn from_values(
+        axes: [[f64; AXIS_LEN]; 3],
+        values: Vec<f32>,
+        name: &Path,
+    ) -> Result<Self, GridError> {
+        let rows = values.len() / 4;
+        if !values.len().is_multiple_of(4) || rows == 0 || !rows.is_multiple_of(GRID_LEN) {
+            return Err(GridError::Format {
+                path: name.to_path_buf(),
+                message: format!(
+                    "{} values is not 4 columns of a positive multiple of {GRID_LEN} rows",
+                    values.len()
+                ),
+            });
+        }
+        if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+            return Err(GridError::Format {
+                path: name.to_path_buf(),
+                message: format!("non-finite value in row {}", i / 4),
+            });
+        }
+        Ok(GridData {
+            axes,
+            n_vertices: rows / GRID_LEN,
+            values,
+        })
+    }
+
     /// (dξ₁, dξ₂, dh, dθ) of vertex `v` at grid point `g`.
     pub fn row(&self, g: usize, v: usize) -> [f64; 4] {
         let i = 4 * (g + GRID_LEN * v);

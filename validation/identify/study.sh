@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# What drives the fit (issue 22, item 6): for each original pattern, at the parameters `run.sh` identified
+# (validation/identify/<pattern>/identified.yarn.json), θ ∂Ψ̄/∂θ along the original material's five 1D ranges
+# (study.png) and the parameter correlations of the default residual set there (report.json), written to
+# validation/identify/<pattern>/drivers/. Run run.sh first.
+#
+#   validation/identify/study.sh [pattern …]
+set -uo pipefail
+cd "$(dirname "$0")/../.."
+HYLC=${HYLC:-target/release/hylc}
+D=${HYLC_SHARED:-../shared}/data/hylc2020
+OUT=validation/identify
+if [ ! -d "$D" ]; then
+  echo "skipped: $D not found (set HYLC_SHARED)"; exit 0
+fi
+declare -A MAT=([basket]=basket1 [satin]=satin1 [slip_stitch_honeycomb]=honey1 [stockinette]=stock1 [cartridge_belt_rib]=rib1)
+declare -A DISP=([basket]=basket [satin]=satin [slip_stitch_honeycomb]=honey [stockinette]=stock [cartridge_belt_rib]=rib)
+PATTERNS=("$@")
+[ ${#PATTERNS[@]} -eq 0 ] && PATTERNS=(basket satin slip_stitch_honeycomb stockinette cartridge_belt_rib)
+for pat in "${PATTERNS[@]}"; do
+  mat=${MAT[$pat]:?unknown pattern $pat}
+  yarn="$OUT/$pat/identified.yarn.json"
+  [ -f "$yarn" ] || { echo "$pat: $yarn missing: run validation/identify/run.sh $pat first"; continue; }
+  mkdir -p "$OUT/$pat/study"
+  echo "== $pat"
+  "$HYLC" identify "$D/patterns/$pat.pyp" --data "$D/displacements/${DISP[$pat]}" --material "$D/materials/$mat.json" \
+    --yarn "$yarn" --max-iterations 0 --no-conventions --study --out "$OUT/$pat/drivers" 2>&1 | tee "$OUT/$pat/drivers/log.txt"
+done
