@@ -1,13 +1,16 @@
 //! The Newton system of a step (`05-macro.md`, "The cloth solver"): the exact Hessian first, the PSD option's
 //! Hessian when it is not positive definite, a growing diagonal shift as the last resort; faer's sparse
-//! Cholesky with the simulation's symbolic analysis.
+//! Cholesky with the simulation's symbolic analysis, numeric factorisation and solve run sequentially (on this
+//! 2-core machine faer's parallel supernodal factorisation spent more time handing work between threads than it
+//! saved: `basket_stretchX` took 1.5× longer with two threads than with one).
 
 use super::Simulation;
 use crate::shell::ShellError;
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::Llt;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::sparse::linalg::cholesky::LltRef;
 use faer::sparse::SparseColMatRef;
-use faer::Side;
+use faer::{Conj, Par, Side};
 
 impl Simulation {
     /// Whether the assembly also produces the exact Hessian (only useful when the PSD option changes it).
@@ -66,10 +69,34 @@ impl Simulation {
     /// positive definite or d is not finite.
     pub(super) fn factor_solve(&self, values: &[f64], g: &[f64]) -> Option<Vec<f64>> {
         let nf = g.len();
+        let sym = &self.symbolic;
+        let req = sym
+            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
+            .or(sym.solve_in_place_scratch::<f64>(1, Par::Seq));
+        let mut buf = MemBuffer::new(req);
         let mat = SparseColMatRef::new(self.pattern.lower.symbolic(), values);
-        let llt = Llt::try_new_with_symbolic(self.symbolic.clone(), mat, Side::Lower).ok()?;
+        let mut factor = vec![0.0; sym.len_val()];
+        sym.factorize_numeric_llt(
+            &mut factor,
+            mat,
+            Side::Lower,
+            LltRegularization {
+                dynamic_regularization_delta: 0.0,
+                dynamic_regularization_epsilon: 0.0,
+            },
+            Par::Seq,
+            MemStack::new(&mut buf),
+            Default::default(),
+        )
+        .ok()?;
+        let llt = LltRef::new(sym, &factor);
         let mut d: Vec<f64> = g.iter().map(|x| -x).collect();
-        llt.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut d, nf, 1));
+        llt.solve_in_place_with_conj(
+            Conj::No,
+            faer::MatMut::from_column_major_slice_mut(&mut d, nf, 1),
+            Par::Seq,
+            MemStack::new(&mut buf),
+        );
         d.iter().all(|x| x.is_finite()).then_some(d)
     }
 }

@@ -39,7 +39,7 @@ use super::mesh::Stencil;
 use super::obstacle::{self, Obstacle};
 use super::strain::NDOF;
 use super::ShellError;
-use faer::sparse::linalg::solvers::SymbolicLlt;
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymbolicCholesky};
 use faer::Side;
 use std::time::Instant;
 use terms::Lagged;
@@ -239,7 +239,7 @@ pub struct Simulation {
     pub model: ElementModel,
     pub stencils: Vec<Stencil>,
     pub pattern: Pattern,
-    symbolic: SymbolicLlt<usize>,
+    symbolic: SymbolicCholesky<usize>,
     pub x0: Vec<f64>,
     pub x: Vec<f64>,
     pub v: Vec<f64>,
@@ -261,7 +261,7 @@ pub struct Simulation {
 }
 
 /// The state and the local PSD Hessians assembled there.
-type DampingCache = (Vec<f64>, Vec<[[f64; NDOF]; NDOF]>);
+type DampingCache = (Vec<f64>, std::sync::Arc<Vec<[[f64; NDOF]; NDOF]>>);
 
 /// Per-substep constants of the potential.
 struct Target {
@@ -344,8 +344,13 @@ impl Simulation {
             return Err(ShellError::Mass);
         }
         let pattern = Pattern::new(&stencils, n, &constrained);
-        let symbolic = SymbolicLlt::try_new(pattern.lower.symbolic(), Side::Lower)
-            .map_err(|source| ShellError::Symbolic { source })?;
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.lower.symbolic(),
+            Side::Lower,
+            Default::default(),
+            Default::default(),
+        )
+        .map_err(|source| ShellError::Symbolic { source })?;
         let x: Vec<f64> = x0.iter().flatten().copied().collect();
         if energy(&model, &stencils, &x).is_none() {
             return Err(non_finite_material(&model, &stencils, &x, None)
@@ -424,7 +429,8 @@ impl Simulation {
                 Substep::Done(done) => {
                     let (mut m, tg) = *done;
                     let local = std::mem::take(&mut m.asm.local);
-                    self.damping_cache = (!local.is_empty()).then(|| (m.x.clone(), local));
+                    self.damping_cache =
+                        (!local.is_empty()).then(|| (m.x.clone(), std::sync::Arc::new(local)));
                     newton += m.newton;
                     substeps += 1;
                     dt_min = dt_min.min(h);

@@ -24,7 +24,7 @@ enum Term {
 /// What a substep freezes at xₙ.
 pub(super) struct Lagged {
     /// per stencil, the PSD elastic Hessian at xₙ (empty without damping)
-    damping: Vec<[[f64; NDOF]; NDOF]>,
+    damping: std::sync::Arc<Vec<[[f64; NDOF]; NDOF]>>,
     /// (c/h) Σ of those Hessians in the pattern's order (empty without damping)
     damping_values: Vec<f64>,
     /// per stencil, its face's drag data (empty without wind)
@@ -38,7 +38,7 @@ impl Simulation {
     pub(super) fn lagged(&self, xn: &[f64], h: f64) -> Result<Lagged, ShellError> {
         let s = &self.settings;
         let dynamic = !s.quasi_static;
-        let mut damping = Vec::new();
+        let mut damping = std::sync::Arc::new(Vec::new());
         let mut damping_values = Vec::new();
         let cached = self
             .damping_cache
@@ -46,6 +46,7 @@ impl Simulation {
             .filter(|(x, local)| x.as_slice() == xn && local.len() == self.stencils.len());
         if dynamic && s.damping > 0.0 && cached.is_some() {
             // the last converged assembly was at xₙ: its local PSD Hessians are the ones needed
+            // (an Arc: shared, not copied)
             damping = cached.map(|c| c.1.clone()).unwrap_or_default();
         } else if dynamic && s.damping > 0.0 {
             // the dissipation must be convex: option (c) (exact Hessian) is replaced by option (b)
@@ -53,37 +54,38 @@ impl Simulation {
             if model.psd == Psd::None {
                 model.psd = Psd::Psi;
             }
-            damping = self
-                .stencils
-                .par_iter()
-                .map(|st| {
-                    let q = gather(st, xn);
-                    let mut g = [0.0; NDOF];
-                    let mut hm = [[0.0; NDOF]; NDOF];
-                    model.energy_gradient_hessian(&q, &st.rest, st.flaps, &mut g, &mut hm)?;
-                    for a in 3..6 {
-                        if !st.flaps[a - 3] || !model.bending {
-                            for r in 0..NDOF {
-                                for k in 0..3 {
-                                    hm[3 * a + k][r] = 0.0;
-                                    hm[r][3 * a + k] = 0.0;
+            damping = std::sync::Arc::new(
+                self.stencils
+                    .par_iter()
+                    .map(|st| {
+                        let q = gather(st, xn);
+                        let mut g = [0.0; NDOF];
+                        let mut hm = [[0.0; NDOF]; NDOF];
+                        model.energy_gradient_hessian(&q, &st.rest, st.flaps, &mut g, &mut hm)?;
+                        for a in 3..6 {
+                            if !st.flaps[a - 3] || !model.bending {
+                                for r in 0..NDOF {
+                                    for k in 0..3 {
+                                        hm[3 * a + k][r] = 0.0;
+                                        hm[r][3 * a + k] = 0.0;
+                                    }
                                 }
                             }
                         }
-                    }
-                    Some(hm)
-                })
-                .collect::<Option<Vec<_>>>()
-                .ok_or_else(|| {
-                    let step = self.steps + 1;
-                    non_finite_material(&self.model, &self.stencils, xn, Some(step))
-                        .unwrap_or(ShellError::Degenerate { step })
-                })?;
+                        Some(hm)
+                    })
+                    .collect::<Option<Vec<_>>>()
+                    .ok_or_else(|| {
+                        let step = self.steps + 1;
+                        non_finite_material(&self.model, &self.stencils, xn, Some(step))
+                            .unwrap_or(ShellError::Degenerate { step })
+                    })?,
+            );
         }
         if !damping.is_empty() {
             damping_values = vec![0.0; self.pattern.nnz()];
             let coh = s.damping / h;
-            for (si, (st, hm)) in self.stencils.iter().zip(&damping).enumerate() {
+            for (si, (st, hm)) in self.stencils.iter().zip(damping.iter()).enumerate() {
                 let scaled = hm.map(|row| row.map(|x| coh * x));
                 self.pattern
                     .add_stencil_hessian(&mut damping_values, si, st, &scaled);
