@@ -4,10 +4,11 @@
 # for 1 s at 1/60 s, PSD `psi` (and `full` for stretch-x); prints one table row per run from the run's log.
 #
 #   cargo build --release && validation/builtins/run.sh        # needs ../shared/data/hylc2020 (skips without it)
+#   MATERIAL=satin1 validation/builtins/run.sh                  # another of the original materials
 set -uo pipefail
 cd "$(dirname "$0")/../.."
 HYLC=${HYLC:-target/release/hylc}
-M=${HYLC_SHARED:-../shared}/data/hylc2020/materials/basket1.json
+M=${HYLC_SHARED:-../shared}/data/hylc2020/materials/${MATERIAL:-basket1}.json
 OUT=${OUT:-out/builtins}
 if [ ! -f "$M" ]; then echo "skipped: $M not found"; exit 0; fi
 mkdir -p "$OUT"
