@@ -180,6 +180,21 @@ pub fn gather(s: &Stencil, x: &[f64]) -> [f64; NDOF] {
     q
 }
 
+/// Zero the rows and columns of a local Hessian that belong to flaps the stencil lacks (or every flap, without
+/// bending).
+pub fn zero_absent_flaps(h: &mut [[f64; NDOF]; NDOF], s: &Stencil, bending: bool) {
+    for a in 3..6 {
+        if !s.flaps[a - 3] || !bending {
+            for r in 0..NDOF {
+                for k in 0..3 {
+                    h[3 * a + k][r] = 0.0;
+                    h[r][3 * a + k] = 0.0;
+                }
+            }
+        }
+    }
+}
+
 /// Result of one assembly.
 #[derive(Clone, Debug)]
 pub struct Assembled {
@@ -289,16 +304,7 @@ fn assemble_with(
                 out.z.push(z);
                 if keep_local {
                     let mut hl = h;
-                    for a in 3..6 {
-                        if !s.flaps[a - 3] || !model.bending {
-                            for r in 0..NDOF {
-                                for k in 0..3 {
-                                    hl[3 * a + k][r] = 0.0;
-                                    hl[r][3 * a + k] = 0.0;
-                                }
-                            }
-                        }
-                    }
+                    zero_absent_flaps(&mut hl, s, model.bending);
                     out.local.push(hl);
                 }
                 for k in 0..6 {
@@ -314,28 +320,10 @@ fn assemble_with(
                     }
                 }
                 if hessian {
-                    let offs = &pattern.offs[ci * chunk + si];
-                    for a in 0..6 {
-                        for b in 0..6 {
-                            let base = 18 * a + 3 * b;
-                            if offs[base] == NONE {
-                                continue;
-                            }
-                            let diag = pattern.free[s.v[a]] == pattern.free[s.v[b]];
-                            for c in 0..3 {
-                                let start = offs[base + c] as usize;
-                                let r0 = if diag { c } else { 0 };
-                                for r in r0..3 {
-                                    out.values[start + r - r0] += h[3 * a + r][3 * b + c];
-                                }
-                                if exact_too {
-                                    for r in r0..3 {
-                                        out.values_exact[start + r - r0] +=
-                                            hx[3 * a + r][3 * b + c];
-                                    }
-                                }
-                            }
-                        }
+                    let k = ci * chunk + si;
+                    pattern.add_stencil_hessian(&mut out.values, k, s, &h);
+                    if exact_too {
+                        pattern.add_stencil_hessian(&mut out.values_exact, k, s, &hx);
                     }
                 }
             }

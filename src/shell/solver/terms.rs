@@ -3,7 +3,7 @@
 //! drag), with the data they freeze at the start of a substep.
 
 use super::{dissipation, non_finite_material, obstacle, Simulation, Target};
-use crate::shell::assemble::{assemble, assemble_keeping, gather, Assembled};
+use crate::shell::assemble::{assemble, assemble_keeping, gather, zero_absent_flaps, Assembled};
 use crate::shell::dissipation::DragFace;
 use crate::shell::element::ElementModel;
 use crate::shell::obstacle::FrictionContact;
@@ -62,16 +62,7 @@ impl Simulation {
                         let mut g = [0.0; NDOF];
                         let mut hm = [[0.0; NDOF]; NDOF];
                         model.energy_gradient_hessian(&q, &st.rest, st.flaps, &mut g, &mut hm)?;
-                        for a in 3..6 {
-                            if !st.flaps[a - 3] || !model.bending {
-                                for r in 0..NDOF {
-                                    for k in 0..3 {
-                                        hm[3 * a + k][r] = 0.0;
-                                        hm[r][3 * a + k] = 0.0;
-                                    }
-                                }
-                            }
-                        }
+                        zero_absent_flaps(&mut hm, st, model.bending);
                         Some(hm)
                     })
                     .collect::<Option<Vec<_>>>()
