@@ -275,3 +275,43 @@ fn steps_that_do_not_converge_are_retried_with_halved_substeps() {
     let err = scene::run(&mut sim, &tris, s.steps(), 0, None, |_| {}).unwrap_err();
     assert!(matches!(err, ShellError::StepFailed { .. }), "{err}");
 }
+
+/// The built-in stretch strips sit where the original's handlebars do (`insetp` 0.16 ± `widthp`/2 = 0.035 of the
+/// side in from the edge, the middle `lengthp` 0.67 along it), not on the edge.
+#[test]
+fn builtin_stretch_strips_follow_the_original_handlebar_geometry() {
+    let side = scene::SIDE;
+    for (name, across) in [("stretch-x", 0), ("stretch-y", 1)] {
+        let s = scene::builtin(name).unwrap();
+        let along = 1 - across;
+        let (sim, _) = s.build("scene.json", Path::new(".")).unwrap();
+        for (i, (h, near_edge)) in s.handles.iter().zip([true, false]).enumerate() {
+            // the flat rectangle's initial positions are its rest layout
+            let held: Vec<[f64; 3]> = sim.handles[i]
+                .vertices
+                .iter()
+                .map(|&v| std::array::from_fn(|k| sim.x0[3 * v + k]))
+                .collect();
+            assert!(!held.is_empty(), "{name} {}", h.name);
+            for p in &held {
+                // distance from the strip's own side, as a fraction of the side
+                let d = if near_edge {
+                    p[across]
+                } else {
+                    side - p[across]
+                } / side;
+                assert!(
+                    (0.125 - 1e-9..=0.195 + 1e-9).contains(&d),
+                    "{name} {}: {d}",
+                    h.name
+                );
+                let a = p[along] / side;
+                assert!(
+                    (0.165 - 1e-9..=0.835 + 1e-9).contains(&a),
+                    "{name} {}: {a}",
+                    h.name
+                );
+            }
+        }
+    }
+}
