@@ -60,7 +60,7 @@ pub fn guess_scale(t: &[f64]) -> f64 {
 
 /// [`locate`] with its guess factor `scale` = [`guess_scale`]`(t)` precomputed. The guess only picks where the
 /// correction starts, so the result is the same cell for any finite factor.
-#[inline]
+#[inline(always)]
 pub fn locate_scaled(t: &[f64], scale: f64, x: f64) -> Piece {
     let n = t.len();
     let (first, last) = (t[0], t[n - 1]);
@@ -188,13 +188,13 @@ impl Hermite1D {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn piece(&self, x: f64) -> usize {
         locate_scaled(&self.t, self.scale, x).index
     }
 
     /// Derivatives f, f′, f″, f‴ at `x` using the polynomial of piece `piece` (which need not contain x).
-    #[inline]
+    #[inline(always)]
     pub fn derivs_on(&self, piece: usize, x: f64) -> [f64; 4] {
         let (x0, ih, c) = &self.pieces[piece];
         let s = (x - x0) * ih;
@@ -202,7 +202,7 @@ impl Hermite1D {
     }
 
     /// f, f′, f″ at x.
-    #[inline]
+    #[inline(always)]
     pub fn eval2(&self, x: f64) -> [f64; 3] {
         let d = self.derivs_on(self.piece(x), x);
         [d[0], d[1], d[2]]
@@ -219,7 +219,7 @@ impl Hermite1D {
 }
 
 /// Value and first three derivatives of `Σ cⱼ sʲ` with respect to x, where ds/dx = `ih`.
-#[inline]
+#[inline(always)]
 pub fn poly_derivs(c: &[f64; 4], s: f64, ih: f64) -> [f64; 4] {
     let v = ((c[3] * s + c[2]) * s + c[1]) * s + c[0];
     let d1 = ((3.0 * c[3]) * s + 2.0 * c[2]) * s + c[1];
@@ -268,7 +268,7 @@ pub struct AtU<'a> {
 }
 
 /// dᵃ/dxᵃ of the monomials (1, s, s², s³), a = 0, 1, 2, for s = (x − x₀)·`ih`.
-#[inline]
+#[inline(always)]
 fn monomial_rows(s: f64, ih: f64) -> [[f64; 4]; 3] {
     let ih2 = ih * ih;
     [
@@ -373,7 +373,7 @@ impl Hermite2D {
     }
 
     /// Restrict to one u (for repeated evaluation along v).
-    #[inline]
+    #[inline(always)]
     pub fn at_u(&self, u: f64) -> AtU<'_> {
         let upiece = locate_scaled(&self.tu, self.scale_u, u).index;
         self.at_u_piece(upiece, u)
@@ -381,7 +381,7 @@ impl Hermite2D {
 
     /// Restrict to one u with the polynomial of u piece `upiece` (which need not contain u), for continuity
     /// checks across grid lines.
-    #[inline]
+    #[inline(always)]
     pub fn at_u_piece(&self, upiece: usize, u: f64) -> AtU<'_> {
         let pc = &self.pieces[upiece];
         AtU {
@@ -391,13 +391,13 @@ impl Hermite2D {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn v_piece(&self, v: f64) -> usize {
         locate_scaled(&self.tv, self.scale_v, v).index
     }
 
     /// f, f_u, f_v, f_uu, f_uv, f_vv at (u, v).
-    #[inline]
+    #[inline(always)]
     pub fn eval2(&self, u: f64, v: f64) -> [f64; 6] {
         self.at_u(u).low_on(self.v_piece(v), v)
     }
@@ -427,14 +427,14 @@ impl Hermite2D {
 
 impl AtU<'_> {
     /// The v piece of `v` (see [`Hermite2D::v_piece`]).
-    #[inline]
+    #[inline(always)]
     pub fn v_piece_of(&self, v: f64) -> usize {
         self.spline.v_piece(v)
     }
 
     /// q_a(t) = ∂ᵃ_u f(u, v) on v piece `vpiece` as power-basis coefficients in t = (v − v₀)/h_v, a = 0, 1, 2:
     /// q_a[j] = Σᵢ c[i][j] dᵃ/duᵃ sⁱ. Returns them with v₀ and 1/h_v.
-    #[inline]
+    #[inline(always)]
     fn rows_on(&self, vpiece: usize) -> ([[f64; 4]; 3], f64, f64) {
         let pc = &self.spline.pieces[vpiece * self.spline.nu_pieces + self.upiece];
         let [s0, s1, s2] = &self.srow;
@@ -449,7 +449,7 @@ impl AtU<'_> {
 
     /// `d[a][b]` = ∂ᵃ_u ∂ᵇ_v f(u, v) for a ≤ 2, b ≤ 3, using the polynomial of v piece `vpiece` (which need not
     /// contain v: the spectral terms evaluate one piece's polynomial at the mean eigenvalue).
-    #[inline]
+    #[inline(always)]
     pub fn derivs_on(&self, vpiece: usize, v: f64) -> Derivs2 {
         let (q, v0, ihv) = self.rows_on(vpiece);
         let t = (v - v0) * ihv;
@@ -461,7 +461,7 @@ impl AtU<'_> {
     }
 
     /// Derivatives of total order ≤ 2 on v piece `vpiece`: (f, f_u, f_v, f_uu, f_uv, f_vv).
-    #[inline]
+    #[inline(always)]
     pub fn low_on(&self, vpiece: usize, v: f64) -> [f64; 6] {
         let (q, v0, ihv) = self.rows_on(vpiece);
         let t = (v - v0) * ihv;

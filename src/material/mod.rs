@@ -147,18 +147,18 @@ impl Material {
                 self.add_bending(&mut out, &inv, g + 3, &bend[g].finish(&eig[g]));
             }
         }
-        for i in 0..6 {
-            for j in 0..i {
-                out.hess[i][j] = out.hess[j][i];
-            }
+        let h = &out.hess;
+        PsiVgh {
+            value: out.value,
+            grad: out.grad,
+            hess: std::array::from_fn(|i| std::array::from_fn(|j| h[i.min(j)][i.max(j)])),
         }
-        out
     }
 
     /// Add the summed bending terms of index `kb`, with derivatives in w = (m, δ, b) and u_k = z_k/σ_k, to ψ's
     /// z-derivatives (upper triangle). m = c (II₀₀ + II₁₁), δ = ±c (II₀₀ − II₁₁) with c = 1/2σ (minus for kb = 4),
     /// b = II₀₁/σ: a linear map R, so ∇_z = Rᵀ∇_w and ∇²_z = Rᵀ∇²_w R.
-    #[inline]
+    #[inline(always)]
     fn add_bending(&self, out: &mut PsiVgh, inv: &[f64; 5], kb: usize, w: &spectral::SpectralW) {
         let ib = inv[kb];
         let c = 0.5 * ib;

@@ -37,11 +37,11 @@ pub trait LambdaFamily {
 }
 
 impl LambdaFamily for Hermite1D {
-    #[inline]
+    #[inline(always)]
     fn piece(&self, lambda: f64) -> usize {
         Hermite1D::piece(self, lambda)
     }
-    #[inline]
+    #[inline(always)]
     fn derivs_on(&self, piece: usize, lambda: f64) -> Derivs2 {
         [
             Hermite1D::derivs_on(self, piece, lambda),
@@ -49,7 +49,7 @@ impl LambdaFamily for Hermite1D {
             [0.0; 4],
         ]
     }
-    #[inline]
+    #[inline(always)]
     fn low_on(&self, piece: usize, lambda: f64) -> [f64; 6] {
         let d = Hermite1D::derivs_on(self, piece, lambda);
         [d[0], 0.0, d[1], 0.0, 0.0, d[2]]
@@ -57,15 +57,15 @@ impl LambdaFamily for Hermite1D {
 }
 
 impl LambdaFamily for super::hermite::AtU<'_> {
-    #[inline]
+    #[inline(always)]
     fn piece(&self, lambda: f64) -> usize {
         self.v_piece_of(lambda)
     }
-    #[inline]
+    #[inline(always)]
     fn derivs_on(&self, piece: usize, lambda: f64) -> Derivs2 {
         super::hermite::AtU::derivs_on(self, piece, lambda)
     }
-    #[inline]
+    #[inline(always)]
     fn low_on(&self, piece: usize, lambda: f64) -> [f64; 6] {
         super::hermite::AtU::low_on(self, piece, lambda)
     }
@@ -83,7 +83,7 @@ pub struct Eigen2 {
 }
 
 impl Eigen2 {
-    #[inline]
+    #[inline(always)]
     pub fn new(m: f64, delta: f64, b: f64) -> Eigen2 {
         let q = delta * delta + b * b;
         Eigen2 {
@@ -133,7 +133,7 @@ pub struct SpectralW {
 
 impl SpectralSum {
     /// Add [φ(u_k, L)]₀₀ for the family `f` (φ(λ) for a 1D term, `u = None`; φ(u_k, λ) for a 2D term, `u = Some(k)`).
-    #[inline]
+    #[inline(always)]
     pub fn add<F: LambdaFamily>(&mut self, f: &F, e: &Eigen2, u: Option<usize>) {
         let (l1, l2) = (e.m + e.d, e.m - e.d);
         let (p1, p2) = (f.piece(l1), f.piece(l2));
@@ -146,7 +146,7 @@ impl SpectralSum {
     }
 
     /// Both eigenvalues on one cubic: G = c₀ + c₁ δ with c₀ = p(m) + p″(m) q/2, c₁ = p′(m) + p‴ q/6, in y = (m, q, δ).
-    #[inline]
+    #[inline(always)]
     fn add_same_piece<F: LambdaFamily>(
         &mut self,
         f: &F,
@@ -180,7 +180,7 @@ impl SpectralSum {
 
     /// Eigenvalues on different pieces: G = c₀ + c₁ δ with c₀ = (φ(λ₁) + φ(λ₂))/2, c₁ = N/d,
     /// N = (φ(λ₁) − φ(λ₂))/2, in y = (m, d, δ) (λ₁,₂ = m ± d).
-    #[inline]
+    #[inline(always)]
     fn add_different_pieces<F: LambdaFamily>(
         &mut self,
         f: &F,
@@ -235,6 +235,7 @@ impl SpectralSum {
 
     /// Map the accumulated y-derivatives to w = (m, δ, b): H_w = Jᵀ H_y J + G_s ∇²s with J = ∂y/∂w (columns
     /// e_m, s_δ e_s + e_δ, s_b e_s), per branch, summed.
+    #[inline(always)]
     pub fn finish(&self, e: &Eigen2) -> SpectralW {
         let mut out = SpectralW {
             value: self.value,
