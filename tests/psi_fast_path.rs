@@ -20,7 +20,7 @@ use hylc::material::{Material, PsiVgh};
 /// reference by a division, and a 1-ulp difference exactly on a knot would pick different pieces (f″ jumps there).
 fn on_knot(x: f64, side: usize) -> f64 {
     let eps = 1e-10 * (1.0 + x.abs());
-    if side % 2 == 0 {
+    if side.is_multiple_of(2) {
         x + eps
     } else {
         x - eps
