@@ -91,7 +91,7 @@ impl Material {
     ///
     /// The in-plane terms add directly. The bending terms of each bending index kb (the 1D term and the 2D terms
     /// (k, kb)) share L/σ_kb, so their eigen-geometry is computed once and their derivatives are summed in the
-    /// spectral variables ([`spectral::SpectralSum`]) before one chain rule to z ([`Material::add_bending`]).
+    /// spectral variables ([`spectral::SpectralSum`]) before one chain rule to z per bending index.
     /// The Hessian is accumulated in its upper triangle and mirrored at the end.
     pub fn eval(&self, z: &[f64; 6]) -> PsiVgh {
         let inv = self.strain_scale.map(|s| 1.0 / s);
