@@ -49,6 +49,19 @@ pub fn piece_from_index(n: usize, index: usize) -> Piece {
 /// originals' two-spacing grids) and then corrected, so the result is always the cell with tᵢ ≤ x < tᵢ₊₁.
 #[inline]
 pub fn locate(t: &[f64], x: f64) -> Piece {
+    locate_scaled(t, guess_scale(t), x)
+}
+
+/// (n − 1)/(tₙ₋₁ − t₀): the factor of [`locate`]'s first guess, stored by the splines so that a lookup needs no
+/// division.
+pub fn guess_scale(t: &[f64]) -> f64 {
+    (t.len() - 1) as f64 / (t[t.len() - 1] - t[0])
+}
+
+/// [`locate`] with its guess factor `scale` = [`guess_scale`]`(t)` precomputed. The guess only picks where the
+/// correction starts, so the result is the same cell for any finite factor.
+#[inline(always)]
+pub fn locate_scaled(t: &[f64], scale: f64, x: f64) -> Piece {
     let n = t.len();
     let (first, last) = (t[0], t[n - 1]);
     if x < first {
@@ -60,7 +73,7 @@ pub fn locate(t: &[f64], x: f64) -> Piece {
         }
     } else {
         // x = t_{n−1} belongs to the last cell; NaN fails both comparisons above and the guess is 0
-        let guess = ((x - first) / (last - first) * (n - 1) as f64) as usize;
+        let guess = ((x - first) * scale) as usize;
         let mut cell = guess.min(n - 2);
         while cell > 0 && t[cell] > x {
             cell -= 1;
@@ -134,6 +147,8 @@ pub struct Hermite1D {
     pub m: Vec<f64>,
     /// per piece: origin, 1/h and power-basis coefficients c₀..c₃ in s
     pieces: Vec<(f64, f64, [f64; 4])>,
+    /// [`guess_scale`] of t
+    scale: f64,
 }
 
 impl Hermite1D {
@@ -163,16 +178,23 @@ impl Hermite1D {
                 (b.origin, 1.0 / b.h, c)
             })
             .collect();
-        Hermite1D { t, p, m, pieces }
+        let scale = guess_scale(&t);
+        Hermite1D {
+            t,
+            p,
+            m,
+            pieces,
+            scale,
+        }
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn piece(&self, x: f64) -> usize {
-        locate(&self.t, x).index
+        locate_scaled(&self.t, self.scale, x).index
     }
 
     /// Derivatives f, f′, f″, f‴ at `x` using the polynomial of piece `piece` (which need not contain x).
-    #[inline]
+    #[inline(always)]
     pub fn derivs_on(&self, piece: usize, x: f64) -> [f64; 4] {
         let (x0, ih, c) = &self.pieces[piece];
         let s = (x - x0) * ih;
@@ -180,7 +202,7 @@ impl Hermite1D {
     }
 
     /// f, f′, f″ at x.
-    #[inline]
+    #[inline(always)]
     pub fn eval2(&self, x: f64) -> [f64; 3] {
         let d = self.derivs_on(self.piece(x), x);
         [d[0], d[1], d[2]]
@@ -197,7 +219,7 @@ impl Hermite1D {
 }
 
 /// Value and first three derivatives of `Σ cⱼ sʲ` with respect to x, where ds/dx = `ih`.
-#[inline]
+#[inline(always)]
 pub fn poly_derivs(c: &[f64; 4], s: f64, ih: f64) -> [f64; 4] {
     let v = ((c[3] * s + c[2]) * s + c[1]) * s + c[0];
     let d1 = ((3.0 * c[3]) * s + 2.0 * c[2]) * s + c[1];
@@ -219,6 +241,9 @@ pub struct Hermite2D {
     /// per (u piece, v piece), u piece inner: origins, 1/h and coefficients c[i][j] of sⁱ tʲ
     pieces: Vec<Piece2>,
     nu_pieces: usize,
+    /// [`guess_scale`] of tu and tv
+    scale_u: f64,
+    scale_v: f64,
 }
 
 #[derive(Clone, Debug)]
@@ -238,7 +263,19 @@ pub type Derivs2 = [[f64; 4]; 3];
 pub struct AtU<'a> {
     spline: &'a Hermite2D,
     upiece: usize,
-    s: f64,
+    /// dᵃ/duᵃ of (1, s, s², s³) for a = 0, 1, 2, s = (u − u₀)/h_u on the u piece
+    srow: [[f64; 4]; 3],
+}
+
+/// dᵃ/dxᵃ of the monomials (1, s, s², s³), a = 0, 1, 2, for s = (x − x₀)·`ih`.
+#[inline(always)]
+fn monomial_rows(s: f64, ih: f64) -> [[f64; 4]; 3] {
+    let ih2 = ih * ih;
+    [
+        [1.0, s, s * s, s * s * s],
+        [0.0, ih, 2.0 * s * ih, 3.0 * s * s * ih],
+        [0.0, 0.0, 2.0 * ih2, 6.0 * s * ih2],
+    ]
 }
 
 impl Hermite2D {
@@ -320,6 +357,7 @@ impl Hermite2D {
                 });
             }
         }
+        let (scale_u, scale_v) = (guess_scale(&tu), guess_scale(&tv));
         Hermite2D {
             tu,
             tv,
@@ -329,39 +367,37 @@ impl Hermite2D {
             muv,
             pieces,
             nu_pieces: nu + 1,
+            scale_u,
+            scale_v,
         }
     }
 
     /// Restrict to one u (for repeated evaluation along v).
-    #[inline]
+    #[inline(always)]
     pub fn at_u(&self, u: f64) -> AtU<'_> {
-        let upiece = locate(&self.tu, u).index;
-        let pc = &self.pieces[upiece];
-        AtU {
-            spline: self,
-            upiece,
-            s: (u - pc.u0) * pc.ihu,
-        }
+        let upiece = locate_scaled(&self.tu, self.scale_u, u).index;
+        self.at_u_piece(upiece, u)
     }
 
     /// Restrict to one u with the polynomial of u piece `upiece` (which need not contain u), for continuity
     /// checks across grid lines.
+    #[inline(always)]
     pub fn at_u_piece(&self, upiece: usize, u: f64) -> AtU<'_> {
         let pc = &self.pieces[upiece];
         AtU {
             spline: self,
             upiece,
-            s: (u - pc.u0) * pc.ihu,
+            srow: monomial_rows((u - pc.u0) * pc.ihu, pc.ihu),
         }
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn v_piece(&self, v: f64) -> usize {
-        locate(&self.tv, v).index
+        locate_scaled(&self.tv, self.scale_v, v).index
     }
 
     /// f, f_u, f_v, f_uu, f_uv, f_vv at (u, v).
-    #[inline]
+    #[inline(always)]
     pub fn eval2(&self, u: f64, v: f64) -> [f64; 6] {
         self.at_u(u).low_on(self.v_piece(v), v)
     }
@@ -391,59 +427,51 @@ impl Hermite2D {
 
 impl AtU<'_> {
     /// The v piece of `v` (see [`Hermite2D::v_piece`]).
-    #[inline]
+    #[inline(always)]
     pub fn v_piece_of(&self, v: f64) -> usize {
         self.spline.v_piece(v)
     }
 
+    /// q_a(t) = ∂ᵃ_u f(u, v) on v piece `vpiece` as power-basis coefficients in t = (v − v₀)/h_v, a = 0, 1, 2:
+    /// q_a[j] = Σᵢ c[i][j] dᵃ/duᵃ sⁱ. Returns them with v₀ and 1/h_v.
+    #[inline(always)]
+    fn rows_on(&self, vpiece: usize) -> ([[f64; 4]; 3], f64, f64) {
+        let pc = &self.spline.pieces[vpiece * self.spline.nu_pieces + self.upiece];
+        let [s0, s1, s2] = &self.srow;
+        let c = &pc.c;
+        // the rows' leading zeros skipped (s1[0] = s2[0] = s2[1] = 0)
+        let q0 =
+            std::array::from_fn(|j| c[0][j] + s0[1] * c[1][j] + s0[2] * c[2][j] + s0[3] * c[3][j]);
+        let q1 = std::array::from_fn(|j| s1[1] * c[1][j] + s1[2] * c[2][j] + s1[3] * c[3][j]);
+        let q2 = std::array::from_fn(|j| s2[2] * c[2][j] + s2[3] * c[3][j]);
+        ([q0, q1, q2], pc.v0, pc.ihv)
+    }
+
     /// `d[a][b]` = ∂ᵃ_u ∂ᵇ_v f(u, v) for a ≤ 2, b ≤ 3, using the polynomial of v piece `vpiece` (which need not
     /// contain v: the spectral terms evaluate one piece's polynomial at the mean eigenvalue).
-    #[inline]
+    #[inline(always)]
     pub fn derivs_on(&self, vpiece: usize, v: f64) -> Derivs2 {
-        let pc = &self.spline.pieces[vpiece * self.spline.nu_pieces + self.upiece];
-        let s = self.s;
-        // q_a[j] = Σ_i c[i][j] dᵃ/dsᵃ sⁱ
-        let mut q = [[0.0; 4]; 3];
-        let (s2, s3) = (s * s, s * s * s);
-        for j in 0..4 {
-            let c = [pc.c[0][j], pc.c[1][j], pc.c[2][j], pc.c[3][j]];
-            q[0][j] = c[0] + c[1] * s + c[2] * s2 + c[3] * s3;
-            q[1][j] = (c[1] + 2.0 * c[2] * s + 3.0 * c[3] * s2) * pc.ihu;
-            q[2][j] = (2.0 * c[2] + 6.0 * c[3] * s) * pc.ihu * pc.ihu;
-        }
-        let t = (v - pc.v0) * pc.ihv;
+        let (q, v0, ihv) = self.rows_on(vpiece);
+        let t = (v - v0) * ihv;
         [
-            poly_derivs(&q[0], t, pc.ihv),
-            poly_derivs(&q[1], t, pc.ihv),
-            poly_derivs(&q[2], t, pc.ihv),
+            poly_derivs(&q[0], t, ihv),
+            poly_derivs(&q[1], t, ihv),
+            poly_derivs(&q[2], t, ihv),
         ]
     }
 
     /// Derivatives of total order ≤ 2 on v piece `vpiece`: (f, f_u, f_v, f_uu, f_uv, f_vv).
-    #[inline]
+    #[inline(always)]
     pub fn low_on(&self, vpiece: usize, v: f64) -> [f64; 6] {
-        let pc = &self.spline.pieces[vpiece * self.spline.nu_pieces + self.upiece];
-        let t = (v - pc.v0) * pc.ihv;
-        let (t2, t3) = (t * t, t * t * t);
-        // r_i = Σ_j c[i][j] tʲ and its first and second t-derivatives
-        let mut r = [0.0; 4];
-        let mut r1 = [0.0; 4];
-        let mut r2 = [0.0; 4];
-        for i in 0..4 {
-            let c = &pc.c[i];
-            r[i] = c[0] + c[1] * t + c[2] * t2 + c[3] * t3;
-            r1[i] = c[1] + 2.0 * c[2] * t + 3.0 * c[3] * t2;
-            r2[i] = 2.0 * c[2] + 6.0 * c[3] * t;
-        }
-        let s = self.s;
-        let (s2, s3) = (s * s, s * s * s);
-        let (iu, iv) = (pc.ihu, pc.ihv);
-        let f = r[0] + r[1] * s + r[2] * s2 + r[3] * s3;
-        let fu = (r[1] + 2.0 * r[2] * s + 3.0 * r[3] * s2) * iu;
-        let fuu = (2.0 * r[2] + 6.0 * r[3] * s) * iu * iu;
-        let fv = (r1[0] + r1[1] * s + r1[2] * s2 + r1[3] * s3) * iv;
-        let fuv = (r1[1] + 2.0 * r1[2] * s + 3.0 * r1[3] * s2) * iu * iv;
-        let fvv = (r2[0] + r2[1] * s + r2[2] * s2 + r2[3] * s3) * iv * iv;
+        let (q, v0, ihv) = self.rows_on(vpiece);
+        let t = (v - v0) * ihv;
+        let [q0, q1, q2] = q;
+        let f = ((q0[3] * t + q0[2]) * t + q0[1]) * t + q0[0];
+        let fu = ((q1[3] * t + q1[2]) * t + q1[1]) * t + q1[0];
+        let fuu = ((q2[3] * t + q2[2]) * t + q2[1]) * t + q2[0];
+        let fv = ((3.0 * q0[3] * t + 2.0 * q0[2]) * t + q0[1]) * ihv;
+        let fuv = ((3.0 * q1[3] * t + 2.0 * q1[2]) * t + q1[1]) * ihv;
+        let fvv = (6.0 * q0[3] * t + 2.0 * q0[2]) * ihv * ihv;
         [f, fu, fv, fuu, fuv, fvv]
     }
 }

@@ -19,7 +19,7 @@ pub use json::MaterialError;
 
 use crate::real::Real;
 use hermite::{basis_piece, basis_weights, piece_from_index};
-use spectral::{spectral_00, spectral_00_reference};
+use spectral::spectral_00_reference;
 
 use crate::strain::compact;
 pub use crate::strain::{Strain6, StrainComponent};
@@ -87,116 +87,105 @@ pub struct PsiVgh {
 }
 
 impl Material {
-    /// Spectral variables (m, δ, b) of bending index `kb` (3 or 4): m = (II₀₀ + II₁₁)/2σ, δ = ±(II₀₀ − II₁₁)/2σ
-    /// (minus for the 11 component: [f(L)]₁₁ is [f(L)]₀₀ with δ → −δ), b = II₀₁/σ.
-    #[inline]
-    fn mdb(&self, kb: usize, z: &[f64; 6]) -> (f64, f64, f64) {
-        let inv = 1.0 / self.strain_scale[kb];
-        let sgn = if kb == 3 { 1.0 } else { -1.0 };
-        (
-            0.5 * inv * (z[3] + z[5]),
-            0.5 * sgn * inv * (z[3] - z[5]),
-            inv * z[4],
-        )
-    }
-
-    /// Add a spectral term's value and w-derivatives, w = (u, m, δ, b), to ψ's z-derivatives.
-    /// `u` is (strain index, 1/σ) of the 2D terms' first argument.
-    #[inline]
-    fn add_spectral(
-        &self,
-        out: &mut PsiVgh,
-        kb: usize,
-        u: Option<(usize, f64)>,
-        s: &spectral::SpectralVgh,
-    ) {
-        let inv = 1.0 / self.strain_scale[kb];
-        let c = 0.5 * inv;
-        let sgn = if kb == 3 { c } else { -c };
-        let g = &s.grad;
-        let h = &s.hess;
-        out.value += s.value;
-        // z-gradient: ∂/∂II₀₀ = c g_m + sgn g_δ, ∂/∂II₁₁ = c g_m − sgn g_δ, ∂/∂II₀₁ = g_b/σ, ∂/∂z_k = g_u/σ_k
-        out.grad[3] += c * g[1] + sgn * g[2];
-        out.grad[5] += c * g[1] - sgn * g[2];
-        out.grad[4] += inv * g[3];
-        // T_j = H R_j for the z directions R_j of II₀₀, II₀₁, II₁₁ (and z_k); H_z[i][j] = R_i · T_j
-        let col = |j: usize| [h[0][j], h[1][j], h[2][j], h[3][j]];
-        let comb = |a: [f64; 4], ca: f64, b: [f64; 4], cb: f64| -> [f64; 4] {
-            std::array::from_fn(|i| ca * a[i] + cb * b[i])
-        };
-        let (c1, c2, c3) = (col(1), col(2), col(3));
-        let t3 = comb(c1, c, c2, sgn);
-        let t5 = comb(c1, c, c2, -sgn);
-        let t4 = comb(c3, inv, c3, 0.0);
-        let dot = |t: &[f64; 4], i: usize| -> f64 {
-            match i {
-                3 => c * t[1] + sgn * t[2],
-                5 => c * t[1] - sgn * t[2],
-                _ => inv * t[3],
-            }
-        };
-        for (j, t) in [(3, &t3), (4, &t4), (5, &t5)] {
-            for i in 3..6 {
-                out.hess[i][j] += dot(t, i);
-            }
-        }
-        if let Some((k, iu)) = u {
-            out.grad[k] += iu * g[0];
-            let tk = comb(col(0), iu, col(0), 0.0);
-            out.hess[k][k] += iu * tk[0];
-            for i in 3..6 {
-                let v = dot(&tk, i);
-                out.hess[i][k] += v;
-                out.hess[k][i] += v;
-            }
-        }
-    }
-
     /// Fast ψ, ∇ψ, ∇²ψ at z = (s_x, s_a, s_y, II₀₀, II₀₁, II₁₁).
+    ///
+    /// The in-plane terms add directly. The bending terms of each bending index kb (the 1D term and the 2D terms
+    /// (k, kb)) share L/σ_kb, so their eigen-geometry is computed once and their derivatives are summed in the
+    /// spectral variables ([`spectral::SpectralSum`]) before one chain rule to z per bending index.
+    /// The Hessian is accumulated in its upper triangle and mirrored at the end.
     pub fn eval(&self, z: &[f64; 6]) -> PsiVgh {
-        let sc = &self.strain_scale;
+        let inv = self.strain_scale.map(|s| 1.0 / s);
         let mut out = PsiVgh {
             value: self.constant,
             grad: [0.0; 6],
             hess: [[0.0; 6]; 6],
         };
+        // (m, δ, b) of L/σ_kb; δ → −δ for the 11 component ([f(L)]₁₁ is [f(L)]₀₀ with δ → −δ)
+        let eig = [3, 4].map(|kb| {
+            let (iv, sgn) = (inv[kb], if kb == 3 { 1.0 } else { -1.0 });
+            spectral::Eigen2::new(
+                0.5 * iv * (z[3] + z[5]),
+                0.5 * sgn * iv * (z[3] - z[5]),
+                iv * z[4],
+            )
+        });
+        let mut bend = [spectral::SpectralSum::default(); 2];
+        let mut used = [false; 2];
         for t in &self.terms1d {
             let k = t.strain.index();
             if k <= 2 {
-                let inv = 1.0 / sc[k];
-                let [f, f1, f2] = t.spline.eval2(z[k] * inv);
+                let [f, f1, f2] = t.spline.eval2(z[k] * inv[k]);
                 out.value += f;
-                out.grad[k] += f1 * inv;
-                out.hess[k][k] += f2 * inv * inv;
+                out.grad[k] += f1 * inv[k];
+                out.hess[k][k] += f2 * inv[k] * inv[k];
             } else {
-                let (m, d, b) = self.mdb(k, z);
-                let s = spectral_00(&t.spline, m, d, b);
-                self.add_spectral(&mut out, k, None, &s);
+                bend[k - 3].add(&t.spline, &eig[k - 3], None);
+                used[k - 3] = true;
             }
         }
         for t in &self.terms2d {
+            // k0 is in-plane and k1 > k0 (the format's rule, checked on load)
             let (k0, k1) = (t.strains[0].index(), t.strains[1].index());
-            let iu = 1.0 / sc[k0];
+            let iu = inv[k0];
             let u = z[k0] * iu;
             if k1 <= 2 {
-                let iv = 1.0 / sc[k1];
+                let iv = inv[k1];
                 let [f, fu, fv, fuu, fuv, fvv] = t.spline.eval2(u, z[k1] * iv);
-                let (a, b) = (k0, k1);
                 out.value += f;
-                out.grad[a] += fu * iu;
-                out.grad[b] += fv * iv;
-                out.hess[a][a] += fuu * iu * iu;
-                out.hess[b][b] += fvv * iv * iv;
-                out.hess[a][b] += fuv * iu * iv;
-                out.hess[b][a] += fuv * iu * iv;
+                out.grad[k0] += fu * iu;
+                out.grad[k1] += fv * iv;
+                out.hess[k0][k0] += fuu * iu * iu;
+                out.hess[k1][k1] += fvv * iv * iv;
+                out.hess[k0][k1] += fuv * iu * iv;
             } else {
-                let (m, d, b) = self.mdb(k1, z);
-                let s = spectral_00(&t.spline.at_u(u), m, d, b);
-                self.add_spectral(&mut out, k1, Some((k0, iu)), &s);
+                bend[k1 - 3].add(&t.spline.at_u(u), &eig[k1 - 3], Some(k0));
+                used[k1 - 3] = true;
             }
         }
-        out
+        for g in 0..2 {
+            if used[g] {
+                self.add_bending(&mut out, &inv, g + 3, &bend[g].finish(&eig[g]));
+            }
+        }
+        let h = &out.hess;
+        PsiVgh {
+            value: out.value,
+            grad: out.grad,
+            hess: std::array::from_fn(|i| std::array::from_fn(|j| h[i.min(j)][i.max(j)])),
+        }
+    }
+
+    /// Add the summed bending terms of index `kb`, with derivatives in w = (m, δ, b) and u_k = z_k/σ_k, to ψ's
+    /// z-derivatives (upper triangle). m = c (II₀₀ + II₁₁), δ = ±c (II₀₀ − II₁₁) with c = 1/2σ (minus for kb = 4),
+    /// b = II₀₁/σ: a linear map R, so ∇_z = Rᵀ∇_w and ∇²_z = Rᵀ∇²_w R.
+    #[inline(always)]
+    fn add_bending(&self, out: &mut PsiVgh, inv: &[f64; 5], kb: usize, w: &spectral::SpectralW) {
+        let ib = inv[kb];
+        let c = 0.5 * ib;
+        let sc = if kb == 3 { c } else { -c };
+        let [gm, gd, gb] = w.g;
+        let [hmm, hmd, hmb, hdd, hdb, hbb] = w.h;
+        out.value += w.value;
+        out.grad[3] += c * gm + sc * gd;
+        out.grad[5] += c * gm - sc * gd;
+        out.grad[4] += ib * gb;
+        // II₀₀ and II₁₁ directions: R₃ = (c, sc, 0), R₅ = (c, −sc, 0); II₀₁: R₄ = (0, 0, 1/σ)
+        let (cc, cs, ss) = (c * c * hmm, c * sc * hmd, sc * sc * hdd);
+        out.hess[3][3] += cc + 2.0 * cs + ss;
+        out.hess[3][5] += cc - ss;
+        out.hess[5][5] += cc - 2.0 * cs + ss;
+        out.hess[3][4] += ib * (c * hmb + sc * hdb);
+        out.hess[4][5] += ib * (c * hmb - sc * hdb);
+        out.hess[4][4] += ib * ib * hbb;
+        for k in 0..3 {
+            let iu = inv[k];
+            let hu = &w.hu[k];
+            out.grad[k] += iu * w.gu[k];
+            out.hess[k][k] += iu * iu * w.huu[k];
+            out.hess[k][3] += iu * (c * hu[0] + sc * hu[1]);
+            out.hess[k][5] += iu * (c * hu[0] - sc * hu[1]);
+            out.hess[k][4] += iu * ib * hu[2];
+        }
     }
 
     /// The admissible range of the material: |z_k| ≤ [`MAX_NORMALISED_STRAIN`] σ_k for z = (s_x, s_a, s_y, II₀₀,

@@ -37,11 +37,11 @@ pub trait LambdaFamily {
 }
 
 impl LambdaFamily for Hermite1D {
-    #[inline]
+    #[inline(always)]
     fn piece(&self, lambda: f64) -> usize {
         Hermite1D::piece(self, lambda)
     }
-    #[inline]
+    #[inline(always)]
     fn derivs_on(&self, piece: usize, lambda: f64) -> Derivs2 {
         [
             Hermite1D::derivs_on(self, piece, lambda),
@@ -49,7 +49,7 @@ impl LambdaFamily for Hermite1D {
             [0.0; 4],
         ]
     }
-    #[inline]
+    #[inline(always)]
     fn low_on(&self, piece: usize, lambda: f64) -> [f64; 6] {
         let d = Hermite1D::derivs_on(self, piece, lambda);
         [d[0], 0.0, d[1], 0.0, 0.0, d[2]]
@@ -57,186 +57,234 @@ impl LambdaFamily for Hermite1D {
 }
 
 impl LambdaFamily for super::hermite::AtU<'_> {
-    #[inline]
+    #[inline(always)]
     fn piece(&self, lambda: f64) -> usize {
         self.v_piece_of(lambda)
     }
-    #[inline]
+    #[inline(always)]
     fn derivs_on(&self, piece: usize, lambda: f64) -> Derivs2 {
         super::hermite::AtU::derivs_on(self, piece, lambda)
     }
-    #[inline]
+    #[inline(always)]
     fn low_on(&self, piece: usize, lambda: f64) -> [f64; 6] {
         super::hermite::AtU::low_on(self, piece, lambda)
     }
 }
 
-/// Value, gradient and Hessian with respect to w = (u, m, δ, b).
+/// The eigen-geometry of one bending group (all terms of one bending index share it): m, δ, b of L/σ (δ sign-flipped
+/// for the 11 component), q = δ² + b², d = √q and the eigenvalues λ₁,₂ = m ± d.
+#[derive(Clone, Copy, Debug)]
+pub struct Eigen2 {
+    pub m: f64,
+    pub delta: f64,
+    pub b: f64,
+    pub q: f64,
+    pub d: f64,
+}
+
+impl Eigen2 {
+    #[inline(always)]
+    pub fn new(m: f64, delta: f64, b: f64) -> Eigen2 {
+        let q = delta * delta + b * b;
+        Eigen2 {
+            m,
+            delta,
+            b,
+            q,
+            d: q.sqrt(),
+        }
+    }
+}
+
+/// Sum of the spectral terms [φ(u_k, L)]₀₀ = c₀ + c₁ δ of one bending group, with first and second derivatives in
+/// w = (m, δ, b) and in the in-plane arguments u_k (k = 0, 1, 2; one per 2D term, none for the 1D term).
+///
+/// Each term is accumulated in its own chart y = (m, s, δ): s = q on the polynomial branch (both eigenvalues on
+/// one piece, see the module documentation), s = d on the divided-difference branch. The chain y → w (through
+/// s(δ, b)) is linear in the accumulated derivatives, so it is applied once per branch in [`SpectralSum::finish`]
+/// instead of once per term.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct SpectralVgh {
+pub struct SpectralSum {
+    value: f64,
+    /// per branch (0: s = q, 1: s = d): whether any term took it
+    used: [bool; 2],
+    /// per branch: gradient in y = (m, s, δ)
+    g: [[f64; 3]; 2],
+    /// per branch: Hessian in y, packed (mm, ms, mδ, ss, sδ, δδ)
+    h: [[f64; 6]; 2],
+    /// ∂/∂u_k and ∂²/∂u_k² (no chain needed)
+    gu: [f64; 3],
+    huu: [f64; 3],
+    /// per branch: ∂²/∂u_k ∂y
+    hu: [[[f64; 3]; 3]; 2],
+}
+
+/// [`SpectralSum`] mapped to w = (m, δ, b): value, gradient, Hessian packed (mm, mδ, mb, δδ, δb, bb), and for
+/// each u_k its first and second derivative and the mixed derivatives ∂²/∂u_k ∂w.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SpectralW {
     pub value: f64,
-    pub grad: [f64; 4],
-    pub hess: [[f64; 4]; 4],
+    pub g: [f64; 3],
+    pub h: [f64; 6],
+    pub gu: [f64; 3],
+    pub huu: [f64; 3],
+    pub hu: [[f64; 3]; 3],
 }
 
-/// G(y) with its gradient and Hessian in y = (u, m, s, δ).
-type GyHy = (f64, [f64; 4], [[f64; 4]; 4]);
+impl SpectralSum {
+    /// Add [φ(u_k, L)]₀₀ for the family `f` (φ(λ) for a 1D term, `u = None`; φ(u_k, λ) for a 2D term, `u = Some(k)`).
+    #[inline(always)]
+    pub fn add<F: LambdaFamily>(&mut self, f: &F, e: &Eigen2, u: Option<usize>) {
+        let (l1, l2) = (e.m + e.d, e.m - e.d);
+        let (p1, p2) = (f.piece(l1), f.piece(l2));
+        if p1 == p2 || e.d <= D_MIN {
+            let piece = if p1 == p2 { p1 } else { f.piece(e.m) };
+            self.add_same_piece(f, piece, e, u);
+        } else {
+            self.add_different_pieces(f, (p1, l1), (p2, l2), e, u);
+        }
+    }
 
-/// G = c₀ + c₁ δ on one polynomial piece, in y = (u, m, q, δ) (see the module documentation).
-#[inline]
-fn same_piece<F: LambdaFamily>(f: &F, piece: usize, m: f64, delta: f64, q: f64) -> GyHy {
-    let [f0, f1, f2] = f.derivs_on(piece, m);
-    let s = q;
-    let g = f0[0] + 0.5 * f0[2] * s + f0[1] * delta + f0[3] * s * delta / 6.0;
-    let gy = [
-        f1[0] + 0.5 * f1[2] * s + f1[1] * delta + f1[3] * s * delta / 6.0,
-        f0[1] + 0.5 * f0[3] * s + f0[2] * delta,
-        0.5 * f0[2] + f0[3] * delta / 6.0,
-        f0[1] + f0[3] * s / 6.0,
-    ];
-    let huu = f2[0] + 0.5 * f2[2] * s + f2[1] * delta + f2[3] * s * delta / 6.0;
-    let hum = f1[1] + 0.5 * f1[3] * s + f1[2] * delta;
-    let hus = 0.5 * f1[2] + f1[3] * delta / 6.0;
-    let hud = f1[1] + f1[3] * s / 6.0;
-    let hmm = f0[2] + f0[3] * delta;
-    let hms = 0.5 * f0[3];
-    let hmd = f0[2];
-    let hsd = f0[3] / 6.0;
-    let hy = [
-        [huu, hum, hus, hud],
-        [hum, hmm, hms, hmd],
-        [hus, hms, 0.0, hsd],
-        [hud, hmd, hsd, 0.0],
-    ];
-    (g, gy, hy)
-}
+    /// Both eigenvalues on one cubic: G = c₀ + c₁ δ with c₀ = p(m) + p″(m) q/2, c₁ = p′(m) + p‴ q/6, in y = (m, q, δ).
+    #[inline(always)]
+    fn add_same_piece<F: LambdaFamily>(
+        &mut self,
+        f: &F,
+        piece: usize,
+        e: &Eigen2,
+        u: Option<usize>,
+    ) {
+        let (q, delta) = (e.q, e.delta);
+        let [f0, f1, f2] = f.derivs_on(piece, e.m);
+        self.value += f0[0] + 0.5 * f0[2] * q + f0[1] * delta + f0[3] * q * delta / 6.0;
+        self.used[0] = true;
+        let g = &mut self.g[0];
+        g[0] += f0[1] + 0.5 * f0[3] * q + f0[2] * delta;
+        g[1] += 0.5 * f0[2] + f0[3] * delta / 6.0;
+        g[2] += f0[1] + f0[3] * q / 6.0;
+        // (mm, mq, mδ, qq, qδ, δδ); G is linear in q and in δ
+        let h = &mut self.h[0];
+        h[0] += f0[2] + f0[3] * delta;
+        h[1] += 0.5 * f0[3];
+        h[2] += f0[2];
+        h[4] += f0[3] / 6.0;
+        if let Some(k) = u {
+            self.gu[k] += f1[0] + 0.5 * f1[2] * q + f1[1] * delta + f1[3] * q * delta / 6.0;
+            self.huu[k] += f2[0] + 0.5 * f2[2] * q + f2[1] * delta + f2[3] * q * delta / 6.0;
+            let hu = &mut self.hu[0][k];
+            hu[0] += f1[1] + 0.5 * f1[3] * q + f1[2] * delta;
+            hu[1] += 0.5 * f1[2] + f1[3] * delta / 6.0;
+            hu[2] += f1[1] + f1[3] * q / 6.0;
+        }
+    }
 
-/// G = c₀ + c₁ δ from φ at λ₁ = m + d on piece `p1` and λ₂ = m − d on piece `p2`, in y = (u, m, d, δ):
-/// c₀ = (φ(λ₁) + φ(λ₂))/2 and c₁ = N/d with N = (φ(λ₁) − φ(λ₂))/2.
-#[inline]
-fn different_pieces<F: LambdaFamily>(
-    f: &F,
-    (p1, l1): (usize, f64),
-    (p2, l2): (usize, f64),
-    delta: f64,
-    d: f64,
-) -> GyHy {
-    // (φ, φ_u, φ_λ, φ_uu, φ_uλ, φ_λλ) at λ₁ and λ₂: only total order ≤ 2 enters
-    let a = f.low_on(p1, l1);
-    let bb = f.low_on(p2, l2);
-    // positions in `low_on`'s output of ∂ᵃ_u ∂ᵇ_λ, keyed (a, b)
-    let at = |i: usize, j: usize| match (i, j) {
-        (0, 0) => 0,
-        (1, 0) => 1,
-        (0, 1) => 2,
-        (2, 0) => 3,
-        (1, 1) => 4,
-        _ => 5,
-    };
-    let half_sum = |i: usize, j: usize| 0.5 * (a[at(i, j)] + bb[at(i, j)]);
-    let half_dif = |i: usize, j: usize| 0.5 * (a[at(i, j)] - bb[at(i, j)]);
-    // c₀(u, m, d) and its derivatives (λ₁ = m + d, λ₂ = m − d)
-    let c0 = half_sum(0, 0);
-    let (c0u, c0m, c0d) = (half_sum(1, 0), half_sum(0, 1), half_dif(0, 1));
-    let (c0uu, c0um, c0ud) = (half_sum(2, 0), half_sum(1, 1), half_dif(1, 1));
-    let (c0mm, c0md, c0dd) = (half_sum(0, 2), half_dif(0, 2), half_sum(0, 2));
-    // N = (φ(λ₁) − φ(λ₂))/2 and c₁ = N/d
-    let n = half_dif(0, 0);
-    let (nu, nm, nd) = (half_dif(1, 0), half_dif(0, 1), half_sum(0, 1));
-    let (nuu, num, nud) = (half_dif(2, 0), half_dif(1, 1), half_sum(1, 1));
-    let (nmm, nmd, ndd) = (half_dif(0, 2), half_sum(0, 2), half_dif(0, 2));
-    let id = 1.0 / d;
-    let c1 = n * id;
-    let (c1u, c1m) = (nu * id, nm * id);
-    let c1d = (nd - c1) * id;
-    let (c1uu, c1um, c1mm) = (nuu * id, num * id, nmm * id);
-    let c1ud = (nud - c1u) * id;
-    let c1md = (nmd - c1m) * id;
-    let c1dd = (ndd - 2.0 * c1d) * id;
-    let g = c0 + c1 * delta;
-    let gy = [c0u + c1u * delta, c0m + c1m * delta, c0d + c1d * delta, c1];
-    let hy = [
-        [
-            c0uu + c1uu * delta,
-            c0um + c1um * delta,
-            c0ud + c1ud * delta,
-            c1u,
-        ],
-        [
-            c0um + c1um * delta,
-            c0mm + c1mm * delta,
-            c0md + c1md * delta,
-            c1m,
-        ],
-        [
-            c0ud + c1ud * delta,
-            c0md + c1md * delta,
-            c0dd + c1dd * delta,
-            c1d,
-        ],
-        [c1u, c1m, c1d, 0.0],
-    ];
-    (g, gy, hy)
-}
+    /// Eigenvalues on different pieces: G = c₀ + c₁ δ with c₀ = (φ(λ₁) + φ(λ₂))/2, c₁ = N/d,
+    /// N = (φ(λ₁) − φ(λ₂))/2, in y = (m, d, δ) (λ₁,₂ = m ± d).
+    #[inline(always)]
+    fn add_different_pieces<F: LambdaFamily>(
+        &mut self,
+        f: &F,
+        at1: (usize, f64),
+        at2: (usize, f64),
+        e: &Eigen2,
+        u: Option<usize>,
+    ) {
+        let delta = e.delta;
+        // (φ, φ_u, φ_λ, φ_uu, φ_uλ, φ_λλ) at λ₁ and λ₂: only total order ≤ 2 enters
+        let (a, bb) = (f.low_on(at1.0, at1.1), f.low_on(at2.0, at2.1));
+        let hs = |i: usize| 0.5 * (a[i] + bb[i]);
+        let hd = |i: usize| 0.5 * (a[i] - bb[i]);
+        let id = 1.0 / e.d;
+        // c₀(m, d) and N(m, d) with their derivatives in (m, d)
+        let (c0, c0m, c0d) = (hs(0), hs(2), hd(2));
+        let (c0mm, c0md, c0dd) = (hs(5), hd(5), hs(5));
+        let (n, nm, nd) = (hd(0), hd(2), hs(2));
+        let (nmm, nmd, ndd) = (hd(5), hs(5), hd(5));
+        let c1 = n * id;
+        let c1m = nm * id;
+        let c1d = (nd - c1) * id;
+        let c1mm = nmm * id;
+        let c1md = (nmd - c1m) * id;
+        let c1dd = (ndd - 2.0 * c1d) * id;
+        self.value += c0 + c1 * delta;
+        self.used[1] = true;
+        let g = &mut self.g[1];
+        g[0] += c0m + c1m * delta;
+        g[1] += c0d + c1d * delta;
+        g[2] += c1;
+        // (mm, md, mδ, dd, dδ, δδ)
+        let h = &mut self.h[1];
+        h[0] += c0mm + c1mm * delta;
+        h[1] += c0md + c1md * delta;
+        h[2] += c1m;
+        h[3] += c0dd + c1dd * delta;
+        h[4] += c1d;
+        if let Some(k) = u {
+            let (c0u, c0uu, c0um, c0ud) = (hs(1), hs(3), hs(4), hd(4));
+            let (nu, nuu, num, nud) = (hd(1), hd(3), hd(4), hs(4));
+            let c1u = nu * id;
+            let c1ud = (nud - c1u) * id;
+            self.gu[k] += c0u + c1u * delta;
+            self.huu[k] += c0uu + nuu * id * delta;
+            let hu = &mut self.hu[1][k];
+            hu[0] += c0um + num * id * delta;
+            hu[1] += c0ud + c1ud * delta;
+            hu[2] += c1u;
+        }
+    }
 
-/// The chain rule y = (u, m, s(δ, b), δ) ← w = (u, m, δ, b): (s_δ, s_b, s_δδ, s_δb, s_bb) for s = q = δ² + b²
-/// (`s_is_q`) or s = d = √q.
-#[inline]
-fn s_derivs(delta: f64, b: f64, d: f64, s_is_q: bool) -> (f64, f64, f64, f64, f64) {
-    if s_is_q {
-        (2.0 * delta, 2.0 * b, 2.0, 0.0, 2.0)
-    } else {
-        let id = 1.0 / d;
-        let id3 = id * id * id;
-        (
-            delta * id,
-            b * id,
-            b * b * id3,
-            -delta * b * id3,
-            delta * delta * id3,
-        )
+    /// Map the accumulated y-derivatives to w = (m, δ, b): H_w = Jᵀ H_y J + G_s ∇²s with J = ∂y/∂w (columns
+    /// e_m, s_δ e_s + e_δ, s_b e_s), per branch, summed.
+    #[inline(always)]
+    pub fn finish(&self, e: &Eigen2) -> SpectralW {
+        let mut out = SpectralW {
+            value: self.value,
+            gu: self.gu,
+            huu: self.huu,
+            ..SpectralW::default()
+        };
+        for branch in 0..2 {
+            if !self.used[branch] {
+                continue;
+            }
+            // (s_δ, s_b, s_δδ, s_δb, s_bb) for s = q or s = d
+            let (sd, sb, sdd, sdb, sbb) = if branch == 0 {
+                (2.0 * e.delta, 2.0 * e.b, 2.0, 0.0, 2.0)
+            } else {
+                let id = 1.0 / e.d;
+                let id3 = id * id * id;
+                (
+                    e.delta * id,
+                    e.b * id,
+                    e.b * e.b * id3,
+                    -e.delta * e.b * id3,
+                    e.delta * e.delta * id3,
+                )
+            };
+            let (g, h) = (&self.g[branch], &self.h[branch]);
+            let gs = g[1];
+            out.g[0] += g[0];
+            out.g[1] += gs * sd + g[2];
+            out.g[2] += gs * sb;
+            let (hmm, hms, hmd, hss, hsd, hdd) = (h[0], h[1], h[2], h[3], h[4], h[5]);
+            out.h[0] += hmm;
+            out.h[1] += hms * sd + hmd;
+            out.h[2] += hms * sb;
+            out.h[3] += (hss * sd + 2.0 * hsd) * sd + hdd + gs * sdd;
+            out.h[4] += (hss * sd + hsd) * sb + gs * sdb;
+            out.h[5] += hss * sb * sb + gs * sbb;
+            for k in 0..3 {
+                let hu = &self.hu[branch][k];
+                out.hu[k][0] += hu[0];
+                out.hu[k][1] += hu[1] * sd + hu[2];
+                out.hu[k][2] += hu[1] * sb;
+            }
+        }
+        out
     }
 }
 
-/// [φ(u, L)]₀₀ = c₀ + c₁ δ with its first and second derivatives in w = (u, m, δ, b).
-/// For the 11 component pass −δ and flip the sign of the δ row/column of the result.
-pub fn spectral_00<F: LambdaFamily>(f: &F, m: f64, delta: f64, b: f64) -> SpectralVgh {
-    let q = delta * delta + b * b;
-    let d = q.sqrt();
-    let (l1, l2) = (m + d, m - d);
-    let (p1, p2) = (f.piece(l1), f.piece(l2));
-    // G(y), y = (u, m, s, δ), with s = q (same piece) or s = d (different pieces); gy and hy its derivatives.
-    let s_is_q = p1 == p2 || d <= D_MIN;
-    let (g, gy, hy) = if s_is_q {
-        let piece = if p1 == p2 { p1 } else { f.piece(m) };
-        same_piece(f, piece, m, delta, q)
-    } else {
-        different_pieces(f, (p1, l1), (p2, l2), delta, d)
-    };
-    // Chain y = (u, m, s(δ, b), δ) ← w = (u, m, δ, b).
-    let (sd, sb, sdd, sdb, sbb) = s_derivs(delta, b, d, s_is_q);
-    // H_w = Jᵀ H_y J + G_s ∇²s with J = ∂y/∂w: columns e_u, e_m, s_δ e_s + e_δ, s_b e_s
-    let h = &hy;
-    let gs = gy[2];
-    let h02 = h[0][2] * sd + h[0][3];
-    let h12 = h[1][2] * sd + h[1][3];
-    let h22 = h[2][2] * sd * sd + 2.0 * h[2][3] * sd + h[3][3] + gs * sdd;
-    let h23 = (h[2][2] * sd + h[2][3]) * sb + gs * sdb;
-    let h33 = h[2][2] * sb * sb + gs * sbb;
-    let (h03, h13) = (h[0][2] * sb, h[1][2] * sb);
-    SpectralVgh {
-        value: g,
-        grad: [gy[0], gy[1], gs * sd + gy[3], gs * sb],
-        hess: [
-            [h[0][0], h[0][1], h02, h03],
-            [h[0][1], h[1][1], h12, h13],
-            [h02, h12, h22, h23],
-            [h03, h13, h23, h33],
-        ],
-    }
-}
-
-/// Generic reference twin of [`spectral_00`]: [φ(L)]₀₀ = c₀ + c₁ δ with c₀, c₁ written as symmetric functions of
+/// Generic reference twin of [`SpectralSum`] for one term: [φ(L)]₀₀ = c₀ + c₁ δ with c₀, c₁ written as symmetric functions of
 /// the eigenvalues. `eval(piece, λ)` evaluates φ at λ with the polynomial of `piece`; `poly(piece)` gives that
 /// polynomial's power-basis coefficients in t = (λ − origin)/h as generic scalars (they depend on u for 2D terms)
 /// together with origin and h.
