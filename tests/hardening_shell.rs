@@ -306,7 +306,7 @@ fn a_diverging_run_stops_with_an_error() {
 }
 
 #[test]
-fn simulate_exits_3_when_the_last_step_did_not_converge_and_0_when_complete() {
+fn simulate_exits_3_when_a_step_fails_even_halved_and_0_when_complete() {
     let base = r#""material": "default", "mesh": {"rectangle": {"width": 0.1, "height": 0.1, "edge": 0.02}},
         "duration": 0.05, "pins": [{"near": {"point": [0, 0], "radius": 0.001}}]"#;
     let capped = temp_file(

@@ -216,21 +216,6 @@ pub fn run(
         &path,
         serde_json::to_string_pretty(&summary).expect("JSON values serialise") + "\n",
     )?;
-    for r in &runs {
-        let n = r.summary["simulate"]["unconverged_steps"]
-            .as_u64()
-            .unwrap_or(0);
-        if n > 0 {
-            log.line(&format!(
-                "note: {}: {n} of {} drape steps ended at the Newton iteration cap (largest residual {:.2e} N; \
-                 they are in {}); a smaller --dt or a finer --edge helps",
-                r.name,
-                r.summary["simulate"]["steps"],
-                r.summary["simulate"]["max_residual"].as_f64().unwrap_or(f64::NAN),
-                r.summary["outputs"]["frames"].as_str().unwrap_or("")
-            ))?;
-        }
-    }
     Ok(summary)
 }
 

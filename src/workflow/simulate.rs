@@ -164,13 +164,6 @@ pub fn diverged(e: &WorkflowError) -> bool {
     )
 }
 
-/// Whether a finished run is complete (`05-macro.md`, exit codes of `hylc simulate`): its last step converged
-/// (steps before it may end at the Newton cap — they are counted in the summary — but the final state must be a
-/// converged step). A run of zero steps is complete.
-pub fn complete(s: &RunSummary) -> bool {
-    s.last.as_ref().is_none_or(|r| r.converged)
-}
-
 /// One-line summary of a finished run.
 pub fn summary_line(s: &RunSummary) -> String {
     format!(

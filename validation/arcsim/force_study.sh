@@ -7,6 +7,8 @@
 #   nodamp  no stiffness-proportional damping (the scene has damping 0.001 s)
 #   hard    handles as hard constraints instead of springs of 1e5 N/m per vertex
 #   fine    every triangle of hylc_square.obj split into four (20 672 triangles; the original refines adaptively)
+#   rect    our regular rectangle mesh of the same size and resolution (0.3 m, edge 6 mm: 5 202 triangles)
+#   coarse  the rectangle mesh at twice the edge (12 mm: 1 250 triangles)
 # Prints one table row per variant: |F_x| (mean of the two handles) at the four times and the difference to the
 # published value (the force along the stretch). Runs stay in $OUT/<variant>/ and are reused unless RERUN=1.
 #
@@ -52,8 +54,11 @@ elif variant == "fine":
     fine = os.path.join(out, "mesh_fine.obj")
     subprocess.run([sys.executable, "validation/arcsim/subdivide_obj.py", s["mesh"]["obj"]["path"], fine], check=True)
     s["mesh"]["obj"]["path"] = os.path.abspath(fine)
+elif variant in ("rect", "coarse"):
+    # the handlebar boxes are in the rest layout [0, 0.3]², which the rectangle mesh shares
+    s["mesh"] = {"rectangle": {"width": 0.3, "height": 0.3, "edge": 0.006 if variant == "rect" else 0.012}}
 elif variant != "base":
-    sys.exit(f"error: unknown variant {variant!r} (base, dt600, nodamp, hard, fine)")
+    sys.exit(f"error: unknown variant {variant!r} (base, dt600, nodamp, hard, fine, rect, coarse)")
 json.dump(s, open(os.path.join(out, "scene.json"), "w"), indent=1)
 PY
   start=$(date +%s.%N)

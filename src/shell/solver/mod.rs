@@ -151,6 +151,9 @@ pub struct StepReport {
     pub dt_min: f64,
     /// largest residual force on a free vertex at the end (N)
     pub residual: f64,
+    /// always true: a substep that does not converge is retried with h halved, and a step that cannot converge
+    /// ends the run with [`ShellError::StepFailed`] instead of a report (kept in the log for the tools that read
+    /// it)
     pub converged: bool,
     pub energy_elastic: f64,
     pub energy_kinetic: f64,
