@@ -19,6 +19,10 @@ pub struct SolverArgs {
     /// wall-time limit per solve in seconds
     #[arg(long)]
     pub time_limit: Option<f64>,
+    /// where H + μI needs a shift above its floor, take the exact Newton step on the constraint space
+    /// (projected conjugate gradients) when H is positive definite there, instead of the shifted step
+    #[arg(long)]
+    pub projected_steps: bool,
 }
 
 impl SolverArgs {
@@ -28,6 +32,7 @@ impl SolverArgs {
             tolerance: self.tolerance,
             max_steps: self.max_steps,
             time_limit: self.time_limit,
+            projected_steps: self.projected_steps,
             ..Default::default()
         }
     }
