@@ -63,6 +63,12 @@ pub struct SolverOptions {
     /// so the problem hash of existing sample files stays.
     #[serde(skip_serializing_if = "is_false")]
     pub projected_steps: bool,
+    /// After a step whose factorisation failed at its first shift (μ had to grow), start the next step at the
+    /// μ that worked instead of μ/10: in a region where H is indefinite, each step then saves the
+    /// factorisation that would fail again. Off (the default): μ/10 after every accepted step, the design's
+    /// rule. Not written to the settings JSON while off.
+    #[serde(skip_serializing_if = "is_false")]
+    pub keep_shift: bool,
     /// Emit one `tracing` event (info level) per Newton step: energy, ‖g‖∞, decrement, μ, step length (`hylc
     /// solve --trace` prints them to stderr).
     pub trace: bool,
@@ -80,6 +86,7 @@ impl Default for SolverOptions {
             backtracking: 0.1,
             contact_margin: crate::tile::contact::DEFAULT_MARGIN,
             projected_steps: false,
+            keep_shift: false,
             trace: false,
         }
     }
@@ -532,7 +539,9 @@ impl MicroProblem {
                 };
                 return Ok(run.finish(state, status, &ev, gnorm));
             }
-            run.mu = (run.mu / 10.0).max(run.mu_floor);
+            if !(opts.keep_shift && run.grew) {
+                run.mu = (run.mu / 10.0).max(run.mu_floor);
+            }
         }
     }
 }
@@ -556,6 +565,8 @@ struct NewtonRun<'p> {
     steps: usize,
     /// Of these, exact steps on the constraint space where H + μI needed a shift above the floor.
     projected: usize,
+    /// Whether μ had to grow in the current step.
+    grew: bool,
     n: usize,
     /// Yarn radius r, stretch stiffness k_s, broad-phase margin, displacement limit d_max, tile area p₁ p₂.
     r: f64,
@@ -600,6 +611,7 @@ impl<'p> NewtonRun<'p> {
             max_mu: 0.0,
             steps: 0,
             projected: 0,
+            grew: false,
             n: problem.pattern.len(),
             r,
             ks: problem.material.stretch_stiffness(),
@@ -675,6 +687,7 @@ impl<'p> NewtonRun<'p> {
         self.mu_floor = 1e-10 * diag_max;
         self.mu = self.mu.max(self.mu_floor);
         let mut delta = None;
+        self.grew = false;
         self.kkt
             .set_matrix(4 * self.n, &lower)
             .map_err(MicroError::Linear)?;
@@ -693,6 +706,7 @@ impl<'p> NewtonRun<'p> {
                 }
                 Ok(_) | Err(FactorError::NotPositiveDefinite) => {
                     self.mu *= 10.0;
+                    self.grew = true;
                 }
                 Err(e) => return Err(MicroError::Linear(e)),
             }

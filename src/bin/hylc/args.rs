@@ -23,6 +23,9 @@ pub struct SolverArgs {
     /// (projected conjugate gradients) when H is positive definite there, instead of the shifted step
     #[arg(long)]
     pub projected_steps: bool,
+    /// after a step whose factorisation needed a larger shift μ, start the next step at that μ (not μ/10)
+    #[arg(long)]
+    pub keep_shift: bool,
 }
 
 impl SolverArgs {
@@ -33,6 +36,7 @@ impl SolverArgs {
             max_steps: self.max_steps,
             time_limit: self.time_limit,
             projected_steps: self.projected_steps,
+            keep_shift: self.keep_shift,
             ..Default::default()
         }
     }
