@@ -177,7 +177,10 @@ pub struct StrainStiffness {
 }
 
 /// The reduced gradient (tile dofs) of a state at its own strain.
-fn gradient_at(problem: &MicroProblem, state: &MicroState) -> Result<Vec<f64>, MicroError> {
+pub(crate) fn gradient_at(
+    problem: &MicroProblem,
+    state: &MicroState,
+) -> Result<Vec<f64>, MicroError> {
     let p = &problem.pattern;
     let elim = Elimination::in_family(p, &state.strain, state.family);
     let mut tile = problem.tile(&elim);

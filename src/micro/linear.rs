@@ -44,13 +44,24 @@ struct SlotPattern {
 }
 
 impl SlotPattern {
-    /// The pattern with the columns `cols` (row lists, unsorted, duplicates allowed) plus the diagonal.
-    fn new(cols: Vec<Vec<usize>>) -> Self {
+    /// The pattern with the columns `cols` (row lists, unsorted, duplicates allowed) plus the diagonal; the slot
+    /// table of `old` (a pattern this one replaces) is reused, only its entries cleared.
+    fn new(cols: Vec<Vec<usize>>, old: Option<SlotPattern>) -> Self {
         let lower = LowerPattern::from_columns(cols);
         let n = lower.n;
         let mut slots = Vec::new();
         if n <= DENSE_SLOTS_MAX {
-            slots = vec![0u32; n * n];
+            match old {
+                Some(o) if o.lower.n == n && o.slots.len() == n * n => {
+                    slots = o.slots;
+                    for j in 0..n {
+                        for &i in o.lower.rows(j) {
+                            slots[i + n * j] = 0;
+                        }
+                    }
+                }
+                _ => slots = vec![0u32; n * n],
+            }
             for j in 0..n {
                 for s in lower.col_ptr[j]..lower.col_ptr[j + 1] {
                     slots[lower.row_idx[s] + n * j] = s as u32 + 1;
@@ -82,6 +93,8 @@ pub struct KktSolver {
     values: Vec<f64>,
     /// factorisation and solve workspace for up to this many right-hand sides (reset with the pattern)
     scratch: Option<(usize, MemBuffer)>,
+    /// `values` holds the factor of the stored H + μI of the last successful factorisation
+    factored: bool,
     /// Number of symbolic analyses performed (for the performance report).
     pub analyses: usize,
 }
@@ -135,6 +148,7 @@ impl KktSolver {
         n: usize,
         lower: &[(usize, usize, f64)],
     ) -> Result<(), FactorError> {
+        self.factored = false;
         if let Some(&(i, j, _)) = lower.iter().find(|t| t.0 >= n || t.1 > t.0) {
             return Err(FactorError::Other(format!(
                 "entry ({i}, {j}) is not in the lower triangle of a {n}×{n} matrix"
@@ -165,7 +179,7 @@ impl KktSolver {
         for (i, j) in missing {
             cols[j].push(i);
         }
-        let pattern = SlotPattern::new(cols);
+        let pattern = SlotPattern::new(cols, self.pattern.take().map(|(p, _)| p));
         let symbolic = factorize_symbolic_cholesky(
             pattern.lower.symbolic(),
             Side::Lower,
@@ -204,7 +218,9 @@ impl KktSolver {
         let lower = &pattern.lower;
         let cols = rhs_list.len().max(a.len()).max(1);
         let buf = workspace(&mut self.scratch, symbolic, cols);
+        self.factored = false;
         let llt = factorize_shifted(symbolic, lower, &self.matrix, mu, &mut self.values, buf)?;
+        self.factored = true;
         let mut solver = ConstrainedSolve::new(llt, buf, lower.n, a)?;
         let mut out = solver.apply(&as_slices(rhs_list));
         for _ in 0..refine {
@@ -252,6 +268,7 @@ impl KktSolver {
         let n = lower.n;
         let cols = a.len().max(1);
         let buf = workspace(&mut self.scratch, symbolic, cols);
+        self.factored = false;
         let mut mu = mu.max(f64::MIN_POSITIVE);
         let mut tries = 0;
         while factorize_shifted(symbolic, lower, &self.matrix, mu, &mut self.values, buf).is_err() {
@@ -262,63 +279,101 @@ impl KktSolver {
             }
         }
         let llt = factorize_shifted(symbolic, lower, &self.matrix, mu, &mut self.values, buf)?;
+        self.factored = true;
         let mut solver = ConstrainedSolve::new(llt, buf, n, a)?;
-        let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
-        let mut out = Vec::with_capacity(rhs_list.len());
-        for b in rhs_list {
-            let mut x = vec![0.0; n];
-            let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
-            // z = M_A⁻¹ r: M z + Aᵀλ = r, A z = 0 (apply returns the negative)
-            let prec = |solver: &mut ConstrainedSolve, r: &[f64]| -> Vec<f64> {
-                solver
-                    .apply(&[r])
-                    .pop()
-                    .expect("one column")
-                    .into_iter()
-                    .map(|v| -v)
-                    .collect()
-            };
-            let mut z = prec(&mut solver, &r);
-            let mut p = z.clone();
-            let mut rz = dot(&r, &z);
-            let rz0 = rz;
-            let mut converged = rz0 <= 0.0;
-            for _ in 0..max_iter {
-                if rz <= tol * tol * rz0 {
-                    converged = true;
-                    break;
-                }
-                let mut hp = vec![0.0; n];
-                lower.add_symmetric_product(&self.matrix, &p, &mut hp);
-                let php = dot(&p, &hp);
-                if php.is_nan() || php <= 0.0 {
-                    return Err(FactorError::NotPositiveDefinite);
-                }
-                let alpha = rz / php;
-                for i in 0..n {
-                    x[i] += alpha * p[i];
-                    r[i] -= alpha * hp[i];
-                }
-                z = prec(&mut solver, &r);
-                let rz_new = dot(&r, &z);
-                let beta = rz_new / rz;
-                for i in 0..n {
-                    p[i] = z[i] + beta * p[i];
-                }
-                rz = rz_new;
-            }
-            if !converged && rz > tol * tol * rz0 {
-                return Err(FactorError::Other(format!(
-                    "projected conjugate gradients did not reach {tol:.0e} in {max_iter} iterations"
-                )));
-            }
-            if x.iter().any(|v| !v.is_finite()) {
-                return Err(FactorError::NotPositiveDefinite);
-            }
-            out.push(x);
-        }
-        Ok(out)
+        rhs_list
+            .iter()
+            .map(|b| projected_cg(&mut solver, lower, &self.matrix, b, tol, max_iter))
+            .collect()
     }
+
+    /// [`solve_projected`](Self::solve_projected) for one right-hand side with the factorisation of H + μI that
+    /// the last successful [`solve_shifted`](Self::solve_shifted) (or `solve_projected`) left, without
+    /// refactorising: the exact constrained Newton step where H + μI needed a larger shift than the floor to
+    /// factorise (H indefinite in the full space) but H may be positive definite on the null space of A. An
+    /// error when no factorisation is kept (none yet, or the matrix changed since), when a search direction has
+    /// pᵀHp ≤ 0, or after `max_iter` iterations.
+    pub fn solve_projected_kept(
+        &mut self,
+        b: &[f64],
+        a: &[Vec<f64>],
+        tol: f64,
+        max_iter: usize,
+    ) -> Result<Vec<f64>, FactorError> {
+        let (Some((pattern, symbolic)), true) = (self.pattern.as_ref(), self.factored) else {
+            return Err(FactorError::Other("no factorisation kept".into()));
+        };
+        let lower = &pattern.lower;
+        let buf = workspace(&mut self.scratch, symbolic, a.len().max(1));
+        let llt = LltRef::new(symbolic, &self.values);
+        let mut solver = ConstrainedSolve::new(llt, buf, lower.n, a)?;
+        projected_cg(&mut solver, lower, &self.matrix, b, tol, max_iter)
+    }
+}
+
+/// Projected preconditioned conjugate gradients for H x + Aᵀλ = −b, A x = 0 (`lower`, `matrix`: H), the
+/// preconditioner the constrained solve `solver` of H + μI, until √(rᵀz) ≤ `tol` times its start value; an error
+/// when a search direction has pᵀHp ≤ 0 or after `max_iter` iterations.
+fn projected_cg(
+    solver: &mut ConstrainedSolve,
+    lower: &LowerPattern,
+    matrix: &[f64],
+    b: &[f64],
+    tol: f64,
+    max_iter: usize,
+) -> Result<Vec<f64>, FactorError> {
+    let n = lower.n;
+    let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
+    let mut x = vec![0.0; n];
+    let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
+    // z = M_A⁻¹ r: M z + Aᵀλ = r, A z = 0 (apply returns the negative)
+    let prec = |solver: &mut ConstrainedSolve, r: &[f64]| -> Vec<f64> {
+        solver
+            .apply(&[r])
+            .pop()
+            .expect("one column")
+            .into_iter()
+            .map(|v| -v)
+            .collect()
+    };
+    let mut z = prec(solver, &r);
+    let mut p = z.clone();
+    let mut rz = dot(&r, &z);
+    let rz0 = rz;
+    let mut converged = rz0 <= 0.0;
+    for _ in 0..max_iter {
+        if rz <= tol * tol * rz0 {
+            converged = true;
+            break;
+        }
+        let mut hp = vec![0.0; n];
+        lower.add_symmetric_product(matrix, &p, &mut hp);
+        let php = dot(&p, &hp);
+        if php.is_nan() || php <= 0.0 {
+            return Err(FactorError::NotPositiveDefinite);
+        }
+        let alpha = rz / php;
+        for i in 0..n {
+            x[i] += alpha * p[i];
+            r[i] -= alpha * hp[i];
+        }
+        z = prec(solver, &r);
+        let rz_new = dot(&r, &z);
+        let beta = rz_new / rz;
+        for i in 0..n {
+            p[i] = z[i] + beta * p[i];
+        }
+        rz = rz_new;
+    }
+    if !converged && rz > tol * tol * rz0 {
+        return Err(FactorError::Other(format!(
+            "projected conjugate gradients did not reach {tol:.0e} in {max_iter} iterations"
+        )));
+    }
+    if x.iter().any(|v| !v.is_finite()) {
+        return Err(FactorError::NotPositiveDefinite);
+    }
+    Ok(x)
 }
 
 /// The rows of a list of vectors as slices.

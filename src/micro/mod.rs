@@ -8,6 +8,7 @@
 pub mod elimination;
 pub mod envelope;
 pub mod linear;
+pub mod predict;
 pub mod reference;
 pub mod sensitivity;
 pub mod solver;
@@ -15,5 +16,6 @@ pub mod strain;
 pub mod surface;
 
 pub use elimination::Elimination;
+pub use predict::Predictor;
 pub use solver::{MicroError, MicroProblem, MicroState, Solution, SolverOptions, Status};
 pub use strain::{Family, MacroStrain, StrainError};

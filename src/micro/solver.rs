@@ -26,6 +26,12 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::time::Instant;
 
+/// Relative tolerance (√(rᵀz) against its start) of the projected conjugate gradients of
+/// [`SolverOptions::projected_steps`].
+const PROJECTED_TOLERANCE: f64 = 1e-10;
+/// Iteration limit of those conjugate gradients (beyond it the shifted step is taken).
+const PROJECTED_MAX_ITERATIONS: usize = 100;
+
 /// Solver settings (`03-homogenization.md`, section 4; defaults from there).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -49,6 +55,20 @@ pub struct SolverOptions {
     pub backtracking: f64,
     /// Broad-phase margin in units of r.
     pub contact_margin: f64,
+    /// Where H + μI factorises only with μ above its floor (H indefinite in the full space), take the exact
+    /// Newton step on the constraint space when H is positive definite there (projected conjugate gradients
+    /// preconditioned by that factorisation), else the shifted step. Off: always the shifted step (the design's
+    /// plain μ regularisation, the default: on the original rib the exact steps reach other, lower equilibria
+    /// than the shifted ones and take more steps; README-micro.md). Not written to the settings JSON while off,
+    /// so the problem hash of existing sample files stays.
+    #[serde(skip_serializing_if = "is_false")]
+    pub projected_steps: bool,
+    /// After a step whose factorisation failed at its first shift (μ had to grow), start the next step at the
+    /// μ that worked instead of μ/10: in a region where H is indefinite, each step then saves the
+    /// factorisation that would fail again. Off (the default): μ/10 after every accepted step, the design's
+    /// rule. Not written to the settings JSON while off.
+    #[serde(skip_serializing_if = "is_false")]
+    pub keep_shift: bool,
     /// Emit one `tracing` event (info level) per Newton step: energy, ‖g‖∞, decrement, μ, step length (`hylc
     /// solve --trace` prints them to stderr).
     pub trace: bool,
@@ -65,9 +85,16 @@ impl Default for SolverOptions {
             slide_constraints: true,
             backtracking: 0.1,
             contact_margin: crate::tile::contact::DEFAULT_MARGIN,
+            projected_steps: false,
+            keep_shift: false,
             trace: false,
         }
     }
+}
+
+/// serde's `skip_serializing_if` for options that are off by default.
+fn is_false(v: &bool) -> bool {
+    !*v
 }
 
 /// How a solve ended.
@@ -203,7 +230,7 @@ pub struct MicroProblem {
     pub pattern: Pattern,
     pub material: YarnMaterial,
     pub options: SolverOptions,
-    topology: RodTopology,
+    pub(super) topology: RodTopology,
     /// Constraint rows A (length 4n each; zero on the angles), normalised.
     constraints: Vec<Vec<f64>>,
 }
@@ -406,62 +433,6 @@ impl MicroProblem {
         state.family = family;
     }
 
-    /// A secant predictor for continuation along a chain of strains: from the equilibria `prev` at z₀ and `cur`
-    /// at z₁ (same family), the state at `target` with y extrapolated linearly, y₁ + (y₁ − y₀)·t, where t is the
-    /// projection of target − z₁ on z₁ − z₀ relative to |z₁ − z₀|² (strain components weighted 1, curvatures by
-    /// the larger period). Returns `None` when the families differ or the step is degenerate; the frames are
-    /// transported to the predicted state.
-    pub fn predict(
-        &self,
-        prev: &MicroState,
-        cur: &MicroState,
-        target: &MacroStrain,
-    ) -> Result<Option<MicroState>, StrainError> {
-        let family = target.validate()?;
-        if prev.family != cur.family || cur.family != family {
-            return Ok(None);
-        }
-        let pmax = self.pattern.periods[0].max(self.pattern.periods[1]);
-        let w = |k: usize| if k < 3 { 1.0 } else { pmax };
-        let d1: Vec<f64> = (0..5)
-            .map(|k| (cur.strain.0[k] - prev.strain.0[k]) * w(k))
-            .collect();
-        let d2: Vec<f64> = (0..5)
-            .map(|k| (target.0[k] - cur.strain.0[k]) * w(k))
-            .collect();
-        let n1: f64 = d1.iter().map(|v| v * v).sum();
-        if n1 <= 0.0 {
-            return Ok(None);
-        }
-        let t = d1.iter().zip(&d2).map(|(a, b)| a * b).sum::<f64>() / n1;
-        if !(t > 0.0 && t <= 2.0) {
-            return Ok(None);
-        }
-        let mut state = cur.clone();
-        self.move_to(&mut state, target)?;
-        let y: Vec<f64> = cur
-            .y
-            .iter()
-            .zip(&prev.y)
-            .map(|(a, b)| a + t * (a - b))
-            .collect();
-        let n = self.pattern.len();
-        let elim = Elimination::in_family(&self.pattern, target, family);
-        let positions: Vec<Vector3<f64>> = (0..n)
-            .map(|v| elim.position(v, [0, 0], &local(&y, v)))
-            .collect();
-        let theta = y[3 * n..].to_vec();
-        state.frames.advance(
-            &self.pattern,
-            &self.topology,
-            positions,
-            theta,
-            &elim.transforms,
-        );
-        state.y = y;
-        Ok(Some(state))
-    }
-
     /// Solve at `strain`, starting from `start` (the reference state when `None`).
     pub fn solve(
         &self,
@@ -546,7 +517,7 @@ impl MicroProblem {
             if opts.trace {
                 tracing::info!(
                     "step {}: E {energy:.15e} J, |g|inf {gnorm:.3e} N, g.d {decrement:.3e} J, mu {:.2e}, \
-                     |d|max {:.3e} m, accepted {}, symbolic analyses {}",
+                     |d|max {:.3e} m, accepted {}, symbolic analyses {}, projected steps {}",
                     run.steps,
                     run.mu,
                     dmax_now.min(run.d_max),
@@ -554,7 +525,8 @@ impl MicroProblem {
                         Some(step) => format!("at {step:.0e}"),
                         None => "none".into(),
                     },
-                    run.kkt.analyses
+                    run.kkt.analyses,
+                    run.projected
                 );
             }
             run.steps += 1;
@@ -567,7 +539,9 @@ impl MicroProblem {
                 };
                 return Ok(run.finish(state, status, &ev, gnorm));
             }
-            run.mu = (run.mu / 10.0).max(run.mu_floor);
+            if !(opts.keep_shift && run.grew) {
+                run.mu = (run.mu / 10.0).max(run.mu_floor);
+            }
         }
     }
 }
@@ -589,6 +563,10 @@ struct NewtonRun<'p> {
     max_mu: f64,
     /// Newton steps taken.
     steps: usize,
+    /// Of these, exact steps on the constraint space where H + μI needed a shift above the floor.
+    projected: usize,
+    /// Whether μ had to grow in the current step.
+    grew: bool,
     n: usize,
     /// Yarn radius r, stretch stiffness k_s, broad-phase margin, displacement limit d_max, tile area p₁ p₂.
     r: f64,
@@ -632,6 +610,8 @@ impl<'p> NewtonRun<'p> {
             mu_floor: 0.0,
             max_mu: 0.0,
             steps: 0,
+            projected: 0,
+            grew: false,
             n: problem.pattern.len(),
             r,
             ks: problem.material.stretch_stiffness(),
@@ -707,6 +687,7 @@ impl<'p> NewtonRun<'p> {
         self.mu_floor = 1e-10 * diag_max;
         self.mu = self.mu.max(self.mu_floor);
         let mut delta = None;
+        self.grew = false;
         self.kkt
             .set_matrix(4 * self.n, &lower)
             .map_err(MicroError::Linear)?;
@@ -725,8 +706,27 @@ impl<'p> NewtonRun<'p> {
                 }
                 Ok(_) | Err(FactorError::NotPositiveDefinite) => {
                     self.mu *= 10.0;
+                    self.grew = true;
                 }
                 Err(e) => return Err(MicroError::Linear(e)),
+            }
+        }
+        // A shift above the floor means H is not positive definite in the full space; it may still be on the
+        // constraint space (e.g. a slide constraint holding back a yarn that would slide), where the exact
+        // Newton step exists: projected conjugate gradients with the factorisation just made as the
+        // preconditioner. Where they meet negative curvature, the shifted step stays.
+        if delta.is_some() && self.mu > self.mu_floor && self.problem.options.projected_steps {
+            let exact = self.kkt.solve_projected_kept(
+                g,
+                &self.problem.constraints,
+                PROJECTED_TOLERANCE,
+                PROJECTED_MAX_ITERATIONS,
+            );
+            if let Ok(d) = exact {
+                if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
+                    delta = Some(d);
+                    self.projected += 1;
+                }
             }
         }
         self.timings.factorization += tf.elapsed().as_secs_f64();

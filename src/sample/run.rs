@@ -5,7 +5,9 @@
 //!   only on its chain and not on scheduling, shards or interruptions.
 //! - Warm start: each step starts from the equilibrium of the step it continues (the nearest converged one up the
 //!   chain), extrapolated with the secant predictor [`MicroProblem::predict`] when that step's own predecessor
-//!   converged too; `cold` starts every sample from the reference state.
+//!   converged too, or with the tangent predictor [`MicroProblem::predict_tangent`] from the step it continues
+//!   ([`RunOptions::predictor`]); `cold` starts every sample from the reference state. A record's `time` includes
+//!   the predictor's.
 //! - The sample file is JSON lines, append-only: one [`Record`] per sample, written as one `write` call of the
 //!   full line and then synced to disk, so an interrupted run loses at most the sample in flight.
 //! - Resume: ids already in the file are skipped (a truncated last line is cut off first). Skipped samples that a
@@ -18,7 +20,7 @@
 use super::plan::{fnv1a64, Plan, Sample, Step};
 use super::SampleError;
 use crate::micro::envelope::strain_derivatives;
-use crate::micro::{MacroStrain, MicroProblem, MicroState, Status};
+use crate::micro::{MacroStrain, MicroProblem, MicroState, Predictor, Status};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::{HashMap, HashSet};
@@ -52,9 +54,10 @@ pub struct Record {
     pub steps: usize,
     /// Final ‖g‖∞ (N), null on error.
     pub gradient_norm: Option<f64>,
-    /// Wall time of the solve (s).
+    /// Wall time of the solve (s), its predictor included.
     pub time: f64,
-    /// How the solve started: `cold`, `warm` (previous equilibrium) or `predicted` (secant predictor).
+    /// How the solve started: `cold`, `warm` (previous equilibrium), `predicted` (secant predictor) or
+    /// `tangent` (tangent predictor).
     pub start: SampleStart,
     /// Hash of (pattern, yarn parameters, solver settings), 16 hex digits ([`problem_hash`]).
     pub problem: String,
@@ -109,6 +112,8 @@ pub enum SampleStart {
     Warm,
     /// From the secant predictor along its chain.
     Predicted,
+    /// From the tangent predictor y* + (dy*/dz)·Δz of the step it continues.
+    Tangent,
 }
 
 /// Options of [`run_plan`].
@@ -120,6 +125,8 @@ pub struct RunOptions {
     pub shard: Option<(usize, usize)>,
     /// Stop after writing this many samples.
     pub limit: Option<usize>,
+    /// The predictor of warm starts.
+    pub predictor: Predictor,
 }
 
 /// What a run did.
@@ -401,17 +408,26 @@ impl PlanRun<'_> {
             .and_then(|k| steps[k].from)
             .filter(|&k| states[k].is_some());
         let mut how = SampleStart::Cold;
-        let predicted = match (a, b) {
-            (Some(a), Some(b)) => match (&states[b], &states[a]) {
+        let tp = Instant::now();
+        let previous = a.and_then(|k| states[k].as_ref());
+        let predicted = match self.opts.predictor {
+            Predictor::Secant => match (b.and_then(|k| states[k].as_ref()), previous) {
                 (Some(sb), Some(sa)) => problem.predict(sb, sa, &strain).ok().flatten(),
                 _ => None,
             },
-            _ => None,
+            Predictor::Tangent => {
+                previous.and_then(|s| problem.predict_tangent(s, &strain).ok().flatten())
+            }
+            Predictor::None => None,
         };
+        let predict_time = tp.elapsed().as_secs_f64();
         let start = if let Some(p) = predicted.as_ref() {
-            how = SampleStart::Predicted;
+            how = match self.opts.predictor {
+                Predictor::Tangent => SampleStart::Tangent,
+                _ => SampleStart::Predicted,
+            };
             Some(p)
-        } else if let Some(s) = a.and_then(|a| states[a].as_ref()) {
+        } else if let Some(s) = previous {
             how = SampleStart::Warm;
             Some(s)
         } else {
@@ -442,12 +458,12 @@ impl PlanRun<'_> {
                 record.status = sol.status.into();
                 record.steps = sol.steps;
                 record.gradient_norm = Some(sol.gradient_norm).filter(|g| g.is_finite());
-                record.time = sol.time;
+                record.time = sol.time + predict_time;
                 (record, ok.then_some(sol.state))
             }
             Err(e) => {
                 record.error = Some(e.to_string());
-                record.time = t.elapsed().as_secs_f64();
+                record.time = t.elapsed().as_secs_f64() + predict_time;
                 (record, None)
             }
         }

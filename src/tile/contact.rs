@@ -91,6 +91,37 @@ pub(super) fn assemble(
     Ok(total)
 }
 
+/// The contact energy alone ([`assemble`] with `Want::Value`): the same pair values summed in the same order.
+pub(super) fn assemble_value(tile: &Tile, y: &[f64], weight: f64) -> Result<f64, ContactError> {
+    let m = &tile.material;
+    let kernel = PairKernel::new(
+        m.contact_stiffness * weight,
+        tile.contact_radius,
+        m.contact_quadrature,
+    )?;
+    let values: Vec<Result<f64, ContactError>> = tile
+        .contacts
+        .par_iter()
+        .map(|pair| {
+            let x: [Vector3<f64>; 4] = pair.points(tile).map(|(v, o)| tile.position(y, v, o));
+            if kernel.beyond_cutoff(&x) {
+                return Ok(0.0);
+            }
+            let la = tile.pattern.edges[pair.a].rest_length;
+            let lb = tile.pattern.edges[pair.b].rest_length;
+            kernel.value(&x, la, lb)
+        })
+        .collect();
+    let mut total = 0.0;
+    for v in values {
+        let v = v?;
+        if v != 0.0 {
+            total += v;
+        }
+    }
+    Ok(total)
+}
+
 /// Broad-phase margin of [`Tile::at_rest_state`] in units of the yarn radius.
 pub const DEFAULT_MARGIN: f64 = 0.5;
 

@@ -227,10 +227,13 @@ impl<'a> Tile<'a> {
         want: Want,
         terms: &Terms,
     ) -> Result<TileEval, ContactError> {
+        if want == Want::Value {
+            return self.evaluate_value(frames, y, terms);
+        }
         let n = self.pattern.len();
         let ks = self.material.stretch_stiffness() * terms.stretch;
         let mut parts = EnergyParts::default();
-        let mut grad = (want != Want::Value).then(|| DVector::zeros(4 * n));
+        let mut grad = Some(DVector::zeros(4 * n));
         // 6² + 11² lower-and-upper entries per vertex for the rods, 12² per contact pair
         let mut trip: Option<Vec<(usize, usize, f64)>> = (want == Want::Hessian)
             .then(|| Vec::with_capacity(157 * n + 144 * self.contacts.len()));
@@ -243,16 +246,8 @@ impl<'a> Tile<'a> {
                     let e = &self.pattern.edges[i];
                     let a = self.position(y, i, [0, 0]);
                     let b = self.position(y, e.end, e.offset);
-                    if want == Want::Value {
-                        Local {
-                            value: stretch_value(&a, &b, e.rest_length, ks),
-                            g: Default::default(),
-                            h: Default::default(),
-                        }
-                    } else {
-                        let (value, g, h) = stretch_vgh(&a, &b, e.rest_length, ks);
-                        Local { value, g, h }
-                    }
+                    let (value, g, h) = stretch_vgh(&a, &b, e.rest_length, ks);
+                    Local { value, g, h }
                 })
                 .collect();
             for (i, l) in locals.iter().enumerate() {
@@ -273,29 +268,16 @@ impl<'a> Tile<'a> {
                     let th = [y[3 * n + s.edges[0]], y[3 * n + s.edges[1]]];
                     let (_, _, fr) = frames.stencil(s, &self.placement);
                     let p = self.bend_params(i, terms);
-                    if want == Want::Value {
-                        let [eb, et] = bend_twist_parts(&x, th, &fr, &p);
-                        (
-                            eb,
-                            et,
-                            Local {
-                                value: eb + et,
-                                g: Default::default(),
-                                h: Default::default(),
-                            },
-                        )
-                    } else {
-                        let ([eb, et], g, h) = bend_twist_parts_vgh(&x, th, &fr, &p);
-                        (
-                            eb,
-                            et,
-                            Local {
-                                value: eb + et,
-                                g,
-                                h,
-                            },
-                        )
-                    }
+                    let ([eb, et], g, h) = bend_twist_parts_vgh(&x, th, &fr, &p);
+                    (
+                        eb,
+                        et,
+                        Local {
+                            value: eb + et,
+                            g,
+                            h,
+                        },
+                    )
                 })
                 .collect();
             for (i, (eb, et, l)) in locals.iter().enumerate() {
@@ -315,6 +297,57 @@ impl<'a> Tile<'a> {
             parts,
             gradient: grad,
             hessian: trip,
+        })
+    }
+
+    /// [`evaluate`](Self::evaluate) for the value alone (the line search's trials): the same stencil values
+    /// summed in the same order, without the local gradient and Hessian storage.
+    fn evaluate_value(
+        &self,
+        frames: &RodState,
+        y: &[f64],
+        terms: &Terms,
+    ) -> Result<TileEval, ContactError> {
+        let n = self.pattern.len();
+        let ks = self.material.stretch_stiffness() * terms.stretch;
+        let mut parts = EnergyParts::default();
+        if terms.stretch != 0.0 {
+            let values: Vec<f64> = (0..n)
+                .into_par_iter()
+                .map(|i| {
+                    let e = &self.pattern.edges[i];
+                    let a = self.position(y, i, [0, 0]);
+                    let b = self.position(y, e.end, e.offset);
+                    stretch_value(&a, &b, e.rest_length, ks)
+                })
+                .collect();
+            for v in values {
+                parts.stretch += v;
+            }
+        }
+        if terms.bend != 0.0 || terms.twist != 0.0 {
+            let values: Vec<[f64; 2]> = (0..n)
+                .into_par_iter()
+                .map(|i| {
+                    let s = &self.topology.stencils[i];
+                    let x = [0, 1, 2].map(|k| self.position(y, s.vertices[k], s.offsets[k]));
+                    let th = [y[3 * n + s.edges[0]], y[3 * n + s.edges[1]]];
+                    let (_, _, fr) = frames.stencil(s, &self.placement);
+                    bend_twist_parts(&x, th, &fr, &self.bend_params(i, terms))
+                })
+                .collect();
+            for [eb, et] in values {
+                parts.bend += eb;
+                parts.twist += et;
+            }
+        }
+        if terms.contact != 0.0 && !self.contacts.is_empty() {
+            parts.contact = contact::assemble_value(self, y, terms.contact)?;
+        }
+        Ok(TileEval {
+            parts,
+            gradient: None,
+            hessian: None,
         })
     }
 

@@ -384,6 +384,7 @@ fn stage_sample(args: &RunConfig, dir: &Path, log: &mut Log) -> Result<Sampled, 
         cold: false,
         shard: None,
         limit: None,
+        predictor: Default::default(),
     };
     let sp = log.sample(&problem, &plan, &samples, &opts)?;
     let holdout = dir.join("holdout.jsonl");

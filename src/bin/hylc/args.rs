@@ -19,6 +19,13 @@ pub struct SolverArgs {
     /// wall-time limit per solve in seconds
     #[arg(long)]
     pub time_limit: Option<f64>,
+    /// where H + μI needs a shift above its floor, take the exact Newton step on the constraint space
+    /// (projected conjugate gradients) when H is positive definite there, instead of the shifted step
+    #[arg(long)]
+    pub projected_steps: bool,
+    /// after a step whose factorisation needed a larger shift μ, start the next step at that μ (not μ/10)
+    #[arg(long)]
+    pub keep_shift: bool,
 }
 
 impl SolverArgs {
@@ -28,6 +35,8 @@ impl SolverArgs {
             tolerance: self.tolerance,
             max_steps: self.max_steps,
             time_limit: self.time_limit,
+            projected_steps: self.projected_steps,
+            keep_shift: self.keep_shift,
             ..Default::default()
         }
     }

@@ -5,6 +5,7 @@ use crate::args::{exit, SolverArgs, YarnArgs};
 use crate::printer::sample_bar;
 use crate::strain::load_pattern_noted;
 use hylc::micro::MicroProblem;
+use hylc::micro::Predictor;
 use hylc::sample::{parse_shard, run_plan_with, RunOptions};
 use hylc::workflow::inputs::load_plan;
 use hylc::workflow::sidecar::write_meta;
@@ -33,6 +34,10 @@ pub struct Args {
     /// stop after writing this many samples
     #[arg(long)]
     limit: Option<usize>,
+    /// predictor of warm starts along a chain: secant (from the two previous equilibria), tangent
+    /// (y* + dy*/dz Δz from the previous one) or none (the previous equilibrium itself)
+    #[arg(long, value_enum, default_value_t = Predictor::Secant)]
+    predictor: Predictor,
     #[command(flatten)]
     solver: SolverArgs,
     #[command(flatten)]
@@ -48,7 +53,12 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let p = load_pattern_noted(pattern)?;
     let problem = MicroProblem::new(p, &yarn, a.solver.options());
     write_meta(out, pattern, &plan, &problem)?;
-    let opts = RunOptions { cold, shard, limit };
+    let opts = RunOptions {
+        cold,
+        shard,
+        limit,
+        predictor: a.predictor,
+    };
     let bar = OnceLock::new();
     let progress = |done: usize, todo: usize| {
         bar.get_or_init(|| sample_bar(todo))

@@ -6,7 +6,7 @@ use crate::strain::{load_pattern_noted, parse_strain};
 use anyhow::anyhow;
 use hylc::micro::envelope::strain_derivatives;
 use hylc::micro::solver::world_positions;
-use hylc::micro::{MacroStrain, MicroProblem, Solution, SolverOptions};
+use hylc::micro::{MacroStrain, MicroProblem, Predictor, Solution, SolverOptions};
 use hylc::strain::StrainComponent;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -24,9 +24,13 @@ pub struct Args {
     /// start every strain from the reference state
     #[arg(long)]
     cold: bool,
-    /// warm start from the previous solution only (no secant extrapolation along the chain)
+    /// warm start from the previous solution only (no extrapolation along the chain; `--predictor none`)
     #[arg(long)]
     no_predictor: bool,
+    /// predictor of warm starts along the chain: secant (from the two previous solutions), tangent
+    /// (y* + dy*/dz Δz from the previous one) or none
+    #[arg(long, value_enum, default_value_t = Predictor::Secant)]
+    predictor: Predictor,
     #[command(flatten)]
     solver: SolverArgs,
     #[command(flatten)]
@@ -72,7 +76,12 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         slide_constraints: !a.no_slide_constraints,
         ..a.solver.options()
     };
-    let (cold, predictor, json_out) = (a.cold, !a.no_predictor, a.json);
+    let predictor = if a.no_predictor {
+        Predictor::None
+    } else {
+        a.predictor
+    };
+    let (cold, json_out) = (a.cold, a.json);
     let p = load_pattern_noted(&a.pattern)?;
     let mut yarn = a.yarn.material()?;
     if let Some(q) = a.quadrature {
@@ -93,20 +102,27 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut prev: Option<Solution> = None;
     let mut before: Option<Solution> = None;
     for (k, strain) in strains.iter().enumerate() {
-        // warm start from the previous solution, extrapolated along the chain when two are available
-        let predicted = match (&before, &prev) {
-            (Some(a), Some(b)) if !cold && predictor && a.psi().is_ok() && b.psi().is_ok() => {
+        // warm start from the previous solution, extrapolated along the chain by the predictor
+        let tp = std::time::Instant::now();
+        let predicted = match (&before, &prev, predictor) {
+            (Some(a), Some(b), Predictor::Secant)
+                if !cold && a.psi().is_ok() && b.psi().is_ok() =>
+            {
                 problem.predict(&a.state, &b.state, strain)?
+            }
+            (_, Some(b), Predictor::Tangent) if !cold && b.psi().is_ok() => {
+                problem.predict_tangent(&b.state, strain)?
             }
             _ => None,
         };
+        let predict_time = tp.elapsed().as_secs_f64();
         let start = if cold {
             None
         } else {
             predicted.as_ref().or(prev.as_ref().map(|s| &s.state))
         };
         let sol = problem.solve(strain, start)?;
-        let r = report(&problem, &sol);
+        let r = report(&problem, &sol, predicted.is_some(), predict_time);
         if json_out {
             println!("{r}");
         } else {
@@ -154,7 +170,12 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     Ok(exit(all_ok, 3))
 }
 
-fn report(problem: &MicroProblem, sol: &Solution) -> serde_json::Value {
+fn report(
+    problem: &MicroProblem,
+    sol: &Solution,
+    predicted: bool,
+    predict_time: f64,
+) -> serde_json::Value {
     let t = &sol.timings;
     let stress = strain_derivatives(problem, &sol.state).ok();
     json!({
@@ -169,7 +190,8 @@ fn report(problem: &MicroProblem, sol: &Solution) -> serde_json::Value {
         "steps": sol.steps,
         "gradient_norm": sol.gradient_norm,
         "time": sol.time,
-        "timings": { "start": t.start, "assembly": t.assembly, "contact": t.contact,
+        "predicted": predicted,
+        "timings": { "predictor": predict_time, "start": t.start, "assembly": t.assembly, "contact": t.contact,
                      "factorization": t.factorization, "line_search": t.line_search },
     })
 }

@@ -1,0 +1,125 @@
+//! Predictors for continuation along a chain of strains (issue 20, item 1): the start state of a solve at a
+//! strain next to one or two equilibria already found.
+//!
+//! - Secant ([`MicroProblem::predict`]): from two equilibria, y extrapolated linearly along the chain.
+//! - Tangent ([`MicroProblem::predict_tangent`]): from one equilibrium y*(z), the first-order change of the
+//!   equilibrium y*(z + Δz) ≈ y*(z) + (dy*/dz)·Δz by the implicit-function theorem (`03-homogenization.md`,
+//!   section 5): dy*·Δz = −H⁻¹ (∂(∇_y E)/∂z · Δz) on the constraint space, with one factorisation of the Newton
+//!   matrix H at the equilibrium ([`equilibrium_response`], as the envelope derivatives use it). The mixed term
+//!   ∂(∇_y E)/∂z · Δz is the difference of the reduced gradients at fixed unknowns between the target strain and
+//!   the equilibrium's own strain (the frames moved with the strain as in a warm start): this equals the
+//!   directional derivative to first order in Δz and keeps the change of the gradient with the strain at fixed
+//!   unknowns exactly, at one gradient evaluation per side.
+//!
+//! Both return the state at the target strain with the frames transported to the predicted unknowns.
+
+use super::elimination::Elimination;
+use super::envelope::gradient_at;
+use super::sensitivity::equilibrium_response;
+use super::solver::{local, MicroError, MicroProblem, MicroState};
+use super::strain::{MacroStrain, StrainError};
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+/// Which predictor a chain of solves uses after its first step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Predictor {
+    /// Linear extrapolation from the two previous equilibria ([`MicroProblem::predict`]).
+    #[default]
+    Secant,
+    /// y* + (dy*/dz)·Δz from the previous equilibrium ([`MicroProblem::predict_tangent`]).
+    Tangent,
+    /// The previous equilibrium itself (moved to the new strain at fixed unknowns).
+    None,
+}
+
+impl MicroProblem {
+    /// A secant predictor for continuation along a chain of strains: from the equilibria `prev` at z₀ and `cur`
+    /// at z₁ (same family), the state at `target` with y extrapolated linearly, y₁ + (y₁ − y₀)·t, where t is the
+    /// projection of target − z₁ on z₁ − z₀ relative to |z₁ − z₀|² (strain components weighted 1, curvatures by
+    /// the larger period). Returns `None` when the families differ or the step is degenerate; the frames are
+    /// transported to the predicted state.
+    pub fn predict(
+        &self,
+        prev: &MicroState,
+        cur: &MicroState,
+        target: &MacroStrain,
+    ) -> Result<Option<MicroState>, StrainError> {
+        let family = target.validate()?;
+        if prev.family != cur.family || cur.family != family {
+            return Ok(None);
+        }
+        let pmax = self.pattern.periods[0].max(self.pattern.periods[1]);
+        let w = |k: usize| if k < 3 { 1.0 } else { pmax };
+        let d1: Vec<f64> = (0..5)
+            .map(|k| (cur.strain.0[k] - prev.strain.0[k]) * w(k))
+            .collect();
+        let d2: Vec<f64> = (0..5)
+            .map(|k| (target.0[k] - cur.strain.0[k]) * w(k))
+            .collect();
+        let n1: f64 = d1.iter().map(|v| v * v).sum();
+        if n1 <= 0.0 {
+            return Ok(None);
+        }
+        let t = d1.iter().zip(&d2).map(|(a, b)| a * b).sum::<f64>() / n1;
+        if !(t > 0.0 && t <= 2.0) {
+            return Ok(None);
+        }
+        let mut state = cur.clone();
+        self.move_to(&mut state, target)?;
+        let y: Vec<f64> = cur
+            .y
+            .iter()
+            .zip(&prev.y)
+            .map(|(a, b)| a + t * (a - b))
+            .collect();
+        self.place(&mut state, y);
+        Ok(Some(state))
+    }
+
+    /// The tangent predictor (module docs): from the equilibrium `cur`, the state at `target` (same family) with
+    /// y = y* + (dy*/dz)·Δz. `None` when the families differ or `target` is `cur`'s own strain.
+    pub fn predict_tangent(
+        &self,
+        cur: &MicroState,
+        target: &MacroStrain,
+    ) -> Result<Option<MicroState>, MicroError> {
+        let family = target.validate_for_radius(self.pattern.radius)?;
+        if cur.family != family || cur.strain == *target {
+            return Ok(None);
+        }
+        let mut state = cur.clone();
+        self.move_to(&mut state, target)?;
+        let g1 = gradient_at(self, &state)?;
+        let g0 = gradient_at(self, cur)?;
+        let b: Vec<f64> = g1.iter().zip(&g0).map(|(a, b)| a - b).collect();
+        let dy = equilibrium_response(self, cur, &[b])?
+            .pop()
+            .expect("one right-hand side");
+        if dy.iter().any(|v| !v.is_finite()) {
+            return Ok(None);
+        }
+        let y: Vec<f64> = cur.y.iter().zip(&dy).map(|(a, d)| a + d).collect();
+        self.place(&mut state, y);
+        Ok(Some(state))
+    }
+
+    /// Set the unknowns of a state already at its strain, transporting its frames to them.
+    fn place(&self, state: &mut MicroState, y: Vec<f64>) {
+        let n = self.pattern.len();
+        let elim = Elimination::in_family(&self.pattern, &state.strain, state.family);
+        let positions: Vec<Vector3<f64>> = (0..n)
+            .map(|v| elim.position(v, [0, 0], &local(&y, v)))
+            .collect();
+        let theta = y[3 * n..].to_vec();
+        state.frames.advance(
+            &self.pattern,
+            &self.topology,
+            positions,
+            theta,
+            &elim.transforms,
+        );
+        state.y = y;
+    }
+}
