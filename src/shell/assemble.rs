@@ -332,11 +332,15 @@ fn assemble_with(
         .collect();
     let mut parts: Vec<Assembled> = parts.into_iter().collect::<Option<Vec<_>>>()?;
     let z: Vec<[f64; 6]> = parts.iter().flat_map(|p| p.z.iter().copied()).collect();
+    // the first part's local Hessians grow by the others' (moved once, not element by element into a vector
+    // that reallocates as it grows)
     let local: Vec<[[f64; NDOF]; NDOF]> = if keep_local {
-        parts
-            .iter_mut()
-            .flat_map(|p| std::mem::take(&mut p.local))
-            .collect()
+        let mut all = std::mem::take(&mut parts[0].local);
+        all.reserve_exact(stencils.len() - all.len());
+        for p in parts.iter_mut().skip(1) {
+            all.append(&mut p.local);
+        }
+        all
     } else {
         vec![]
     };
