@@ -8,6 +8,8 @@
 //!   converged too, or with the tangent predictor [`MicroProblem::predict_tangent`] from the step it continues
 //!   ([`RunOptions::predictor`]); `cold` starts every sample from the reference state. A record's `time` includes
 //!   the predictor's.
+//! - Multi-start ([`RunOptions::starts`], [`super::starts`]; issue 19, item 1): `warm+cold` also solves every
+//!   sample from the reference state and writes the lowest converged Ψ̄, listing every start.
 //! - The sample file is JSON lines, append-only: one [`Record`] per sample, written as one `write` call of the
 //!   full line and then synced to disk, so an interrupted run loses at most the sample in flight.
 //! - Resume: ids already in the file are skipped (a truncated last line is cut off first). Skipped samples that a
@@ -18,6 +20,7 @@
 //!   duplicate ids.
 
 use super::plan::{fnv1a64, Plan, Sample, Step};
+use super::starts::{keep, StartKind, StartResult, Starts};
 use super::SampleError;
 use crate::micro::envelope::strain_derivatives;
 use crate::micro::{MacroStrain, MicroProblem, MicroState, Predictor, Status};
@@ -61,6 +64,13 @@ pub struct Record {
     pub start: SampleStart,
     /// Hash of (pattern, yarn parameters, solver settings), 16 hex digits ([`problem_hash`]).
     pub problem: String,
+    /// Every start of a multi-start sample ([`RunOptions::starts`]; issue 19, item 1); empty (omitted) when the
+    /// sample was solved from one start.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub starts: Vec<StartResult>,
+    /// Which of `starts` the record's `psi`, `stress`, `status` and `steps` are (omitted with one start).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kept: Option<StartKind>,
 }
 
 impl Record {
@@ -127,6 +137,8 @@ pub struct RunOptions {
     pub limit: Option<usize>,
     /// The predictor of warm starts.
     pub predictor: Predictor,
+    /// The starts of every sample (issue 19, item 1; [`super::starts`]); not with `cold`.
+    pub starts: Starts,
 }
 
 /// What a run did.
@@ -248,6 +260,9 @@ pub fn run_plan_with(
 ) -> Result<RunSummary, SampleError> {
     let t0 = Instant::now();
     plan.validate()?;
+    if opts.cold && opts.starts != Starts::Warm {
+        return Err(SampleError::Starts(opts.starts.to_string()));
+    }
     let hash = problem_hash(problem);
     let existing = read_samples(out, true)?;
     if let Some(r) = existing.iter().find(|r| r.problem != hash) {
@@ -374,8 +389,20 @@ impl PlanRun<'_> {
                 self.stop.store(true, Ordering::Relaxed);
                 break;
             }
-            let (record, state) = self.solve(steps, step, &states, sample);
+            let (record, state) = self.solve(steps, step, &states, sample, self.opts.cold);
             states[i] = state;
+            // warm+cold: the cold start too, unless the chain's start was cold already (no converged step up
+            // the chain); only the record changes, the chain continues from its warm equilibria
+            let record = match self.opts.starts {
+                Starts::Warm => record,
+                Starts::WarmCold if record.start == SampleStart::Cold => {
+                    keep(vec![(StartKind::Cold, record)])
+                }
+                Starts::WarmCold => {
+                    let (cold, _) = self.solve(steps, step, &states, sample, true);
+                    keep(vec![(StartKind::Warm, record), (StartKind::Cold, cold)])
+                }
+            };
             if write {
                 if !self.write(&record) {
                     break;
@@ -393,11 +420,12 @@ impl PlanRun<'_> {
         step: &Step,
         states: &[Option<MicroState>],
         sample: &Sample,
+        cold: bool,
     ) -> (Record, Option<MicroState>) {
         let problem = self.problem;
         let strain = MacroStrain(sample.z);
         // the nearest converged step up the chain, and its own converged predecessor
-        let mut a = if self.opts.cold { None } else { step.from };
+        let mut a = if cold { None } else { step.from };
         while let Some(k) = a {
             if states[k].is_some() {
                 break;
@@ -447,6 +475,8 @@ impl PlanRun<'_> {
             time: 0.0,
             start: how,
             problem: self.hash.to_string(),
+            starts: vec![],
+            kept: None,
         };
         match problem.solve(&strain, start) {
             Ok(sol) => {
@@ -599,6 +629,8 @@ mod tests {
             time: 0.01,
             start: SampleStart::Cold,
             problem: "0".into(),
+            starts: vec![],
+            kept: None,
         };
         let line = serde_json::to_string(&r).unwrap();
         std::fs::write(&path, format!("{line}\n{}", &line[..20])).unwrap();
@@ -629,6 +661,8 @@ mod tests {
             time: 0.01,
             start: SampleStart::Cold,
             problem: "0".into(),
+            starts: vec![],
+            kept: None,
         };
         std::fs::write(&path, format!("\u{feff}{}", record_line(&r))).unwrap();
         assert_eq!(read_samples(&path, true).unwrap(), vec![r.clone()]);
