@@ -181,6 +181,77 @@ fn warm_and_cold_resumed_and_sharded_give_the_same_records() {
 }
 
 #[test]
+fn all_tries_the_reversed_chain_where_warm_and_cold_disagree() {
+    let d = dir("all");
+    let (problem, plan) = (problem(), tiny_plan());
+    let all_opts = || RunOptions {
+        starts: Starts::All,
+        ..Default::default()
+    };
+    let wc = run(&problem, &plan, &d.join("wc.jsonl"), both());
+    let all = run(&problem, &plan, &d.join("all.jsonl"), all_opts());
+    assert_eq!(all.len(), plan.len());
+    let disagree = |r: &Record| {
+        let (w, c) = (r.starts.first().unwrap(), r.starts.last().unwrap());
+        r.starts.len() == 2
+            && match (w.psi, c.psi) {
+                (Some(a), Some(b)) => (a - b).abs() > 1e-6 * a.abs().max(b.abs()),
+                (a, b) => a.is_some() != b.is_some(),
+            }
+    };
+    let mut reversed = 0;
+    for (id, r) in &all {
+        let q = &wc[id];
+        // the forward pass is warm+cold's; reversed starts only where warm and cold disagree
+        assert_eq!(r.starts[..q.starts.len()], q.starts[..], "{id}");
+        let extra = &r.starts[q.starts.len()..];
+        assert!(extra.iter().all(|s| s.kind == StartKind::Reverse), "{id}");
+        if !disagree(q) {
+            assert!(extra.is_empty(), "{id}");
+        }
+        reversed += extra.len();
+        // the kept Ψ̄ is ≤ warm+cold's, and the minimum of the starts
+        if let Some(p) = q.converged_psi() {
+            assert!(r.converged_psi().is_some_and(|k| k <= p), "{id}");
+        }
+        let min = r
+            .starts
+            .iter()
+            .filter_map(|s| s.psi)
+            .fold(f64::INFINITY, f64::min);
+        if min.is_finite() {
+            assert_eq!(
+                r.converged_psi().map(f64::to_bits),
+                Some(min.to_bits()),
+                "{id}"
+            );
+        }
+    }
+    assert!(
+        wc.values().any(disagree),
+        "the tiny plan has samples where warm and cold disagree"
+    );
+    assert!(reversed > 0);
+    // resumed and sharded: the same records
+    let text = std::fs::read(d.join("all.jsonl")).unwrap();
+    let cut = d.join("cut.jsonl");
+    std::fs::write(&cut, &text[..text.len() / 2 + 7]).unwrap();
+    assert_eq!(run(&problem, &plan, &cut, all_opts()), all);
+    let files: Vec<PathBuf> = (0..2).map(|k| d.join(format!("s{k}.jsonl"))).collect();
+    for (k, f) in files.iter().enumerate() {
+        let opts = RunOptions {
+            shard: Some((k, 2)),
+            ..all_opts()
+        };
+        run(&problem, &plan, f, opts);
+    }
+    let m = d.join("merged.jsonl");
+    merge(&m, &[files[0].as_path(), files[1].as_path()]).unwrap();
+    assert_eq!(by_id(read_samples(&m, false).unwrap()), all);
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
 fn cli_starts_and_compare_samples() {
     let d = dir("cli");
     let exe = env!("CARGO_BIN_EXE_hylc");
@@ -206,6 +277,18 @@ fn cli_starts_and_compare_samples() {
         "--cold",
     ]);
     assert!(err.contains("--starts warm+cold with --cold"), "{err}");
+    let err = cli_error(&[
+        "sample",
+        "plain",
+        "--plan",
+        &pf,
+        "--out",
+        &o,
+        "--starts",
+        "all",
+        "--disagreement=-1",
+    ]);
+    assert!(err.contains("--disagreement"), "{err}");
 
     let sample = |out: &Path, extra: &[&str]| {
         let o = out.display().to_string();

@@ -44,4 +44,7 @@ pub enum SampleError {
     /// `--starts` other than `warm` with `--cold` (the cold start is one of the starts).
     #[error("--starts {0} with --cold: --cold solves from the reference state only; drop --cold")]
     Starts(String),
+    /// A disagreement tolerance of `--starts all` that is not a finite number ≥ 0.
+    #[error("--disagreement: expected a finite relative tolerance ≥ 0, got {0}")]
+    Disagreement(f64),
 }

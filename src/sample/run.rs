@@ -124,6 +124,8 @@ pub enum SampleStart {
     Predicted,
     /// From the tangent predictor y* + (dy*/dz)·Δz of the step it continues.
     Tangent,
+    /// From the kept equilibrium of a step that continues it (the reversed chain; `--starts all`).
+    Reverse,
 }
 
 /// Options of [`run_plan`].
@@ -139,6 +141,9 @@ pub struct RunOptions {
     pub predictor: Predictor,
     /// The starts of every sample (issue 19, item 1; [`super::starts`]); not with `cold`.
     pub starts: Starts,
+    /// `Starts::All`: the relative difference of the warm and the cold Ψ̄ above which the reversed chain is tried
+    /// too ([`super::starts::DEFAULT_DISAGREEMENT`] when `None`).
+    pub disagreement: Option<f64>,
 }
 
 /// What a run did.
@@ -263,6 +268,9 @@ pub fn run_plan_with(
     if opts.cold && opts.starts != Starts::Warm {
         return Err(SampleError::Starts(opts.starts.to_string()));
     }
+    if let Some(d) = opts.disagreement.filter(|d| !(d.is_finite() && *d >= 0.0)) {
+        return Err(SampleError::Disagreement(d));
+    }
     let hash = problem_hash(problem);
     let existing = read_samples(out, true)?;
     if let Some(r) = existing.iter().find(|r| r.problem != hash) {
@@ -335,12 +343,12 @@ pub fn run_plan_with(
 }
 
 /// The shared state of one [`run_plan_with`]: the inputs, the sample file and the counters the chains update.
-struct PlanRun<'a> {
+pub(super) struct PlanRun<'a> {
     problem: &'a MicroProblem,
-    samples: &'a [Sample],
+    pub(super) samples: &'a [Sample],
     /// Ids already in the sample file.
-    done: &'a HashSet<String>,
-    opts: &'a RunOptions,
+    pub(super) done: &'a HashSet<String>,
+    pub(super) opts: &'a RunOptions,
     hash: &'a str,
     out: &'a Path,
     file: Mutex<File>,
@@ -349,10 +357,10 @@ struct PlanRun<'a> {
     progress: &'a (dyn Fn(usize, usize) + Sync),
     written: AtomicUsize,
     /// Records claimed against `opts.limit`.
-    slots: AtomicUsize,
+    pub(super) slots: AtomicUsize,
     converged: AtomicUsize,
-    replayed: AtomicUsize,
-    stop: AtomicBool,
+    pub(super) replayed: AtomicUsize,
+    pub(super) stop: AtomicBool,
     failure: Mutex<Option<SampleError>>,
 }
 
@@ -360,6 +368,9 @@ impl PlanRun<'_> {
     /// One chain, in order: its unfinished steps and (warm) every step they continue from, each started from the
     /// nearest converged step up the chain.
     fn chain(&self, steps: &[Step]) {
+        if self.opts.starts == Starts::All {
+            return self.chain_all(steps);
+        }
         let mut need: Vec<bool> = steps
             .iter()
             .map(|s| !self.done.contains(&self.samples[s.sample].id))
@@ -394,7 +405,7 @@ impl PlanRun<'_> {
             // warm+cold: the cold start too, unless the chain's start was cold already (no converged step up
             // the chain); only the record changes, the chain continues from its warm equilibria
             let record = match self.opts.starts {
-                Starts::Warm => record,
+                Starts::Warm | Starts::All => record,
                 Starts::WarmCold if record.start == SampleStart::Cold => {
                     keep(vec![(StartKind::Cold, record)])
                 }
@@ -414,7 +425,7 @@ impl PlanRun<'_> {
     }
 
     /// Solve one step from its start (secant prediction, warm or cold); the record, and the state when converged.
-    fn solve(
+    pub(super) fn solve(
         &self,
         steps: &[Step],
         step: &Step,
@@ -461,6 +472,20 @@ impl PlanRun<'_> {
         } else {
             None
         };
+        self.solve_from(sample, start, how, predict_time)
+    }
+
+    /// Solve one sample from `start` (the reference state when `None`), `how` naming the start; the record, and
+    /// the state when converged. `predict_time` (s) is added to the record's time.
+    pub(super) fn solve_from(
+        &self,
+        sample: &Sample,
+        start: Option<&MicroState>,
+        how: SampleStart,
+        predict_time: f64,
+    ) -> (Record, Option<MicroState>) {
+        let problem = self.problem;
+        let strain = MacroStrain(sample.z);
         let t = Instant::now();
         let mut record = Record {
             id: sample.id.clone(),
@@ -501,7 +526,7 @@ impl PlanRun<'_> {
 
     /// Append a record as a single write of the full line, then sync it to disk; count it and report progress.
     /// False (and the run stops) when the file cannot be written.
-    fn write(&self, record: &Record) -> bool {
+    pub(super) fn write(&self, record: &Record) -> bool {
         let line = record_line(record);
         let result = match self.file.lock() {
             Ok(mut f) => f

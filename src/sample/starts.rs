@@ -8,12 +8,20 @@
 //!   chain still continues from its warm equilibria, so the warm start of every sample is the one of a `warm` run
 //!   and the cold start the one of a `--cold` run: the kept Ψ̄ is ≤ both wherever they converged, and it depends
 //!   only on the sample's chain (not on scheduling, shards or resume).
+//! - [`Starts::All`] adds, for every sample whose warm and cold starts disagree (by more than
+//!   [`RunOptions::disagreement`](super::RunOptions::disagreement) relative, or one converged and the other not),
+//!   a start from the kept equilibrium of every step that continues it: the chain run in reverse, in a second pass
+//!   after the forward pass, so a chain's records are written when the chain is done, and resuming a chain with
+//!   an unfinished step solves the whole chain again (its finished records are not rewritten).
 //! - [`compare`] checks two sample files of one plan for agreement (e.g. warm-first against cold-first): the
 //!   samples converged in both whose Ψ̄ differ by more than a relative tolerance, with both energies.
 
-use super::run::{Record, SampleStatus};
+use super::plan::Step;
+use super::run::{PlanRun, Record, SampleStart, SampleStatus};
+use crate::micro::MicroState;
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
+use std::sync::atomic::Ordering;
 
 /// Which starts each sample is solved from (`hylc sample --starts`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -24,13 +32,20 @@ pub enum Starts {
     /// The warm start and the cold start (reference state); the lowest converged Ψ̄ is kept.
     #[value(name = "warm+cold")]
     WarmCold,
+    /// Warm and cold, and where they disagree the reversed chain (starts from the steps that continue a sample).
+    All,
 }
+
+/// The default relative disagreement of the warm and the cold Ψ̄ above which `--starts all` tries the reversed
+/// chain.
+pub const DEFAULT_DISAGREEMENT: f64 = 1e-6;
 
 impl std::fmt::Display for Starts {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
             Starts::Warm => "warm",
             Starts::WarmCold => "warm+cold",
+            Starts::All => "all",
         })
     }
 }
@@ -44,6 +59,8 @@ pub enum StartKind {
     Warm,
     /// The reference state.
     Cold,
+    /// The kept equilibrium of a step that continues this one along the chain (`--starts all`).
+    Reverse,
 }
 
 /// One start of a multi-start sample: Ψ̄ when converged (else null), status and Newton steps.
@@ -60,15 +77,7 @@ pub struct StartResult {
 /// the converged one with the lowest Ψ̄ (the first of equal ones), or the first when none converged; it gets the
 /// list of all starts, the kind kept and the summed wall time.
 pub fn keep(solves: Vec<(StartKind, Record)>) -> Record {
-    let mut best: Option<(usize, f64)> = None;
-    for (i, (_, r)) in solves.iter().enumerate() {
-        if let Some(p) = r.converged_psi() {
-            if best.is_none_or(|(_, b)| p < b) {
-                best = Some((i, p));
-            }
-        }
-    }
-    let k = best.map_or(0, |(i, _)| i);
+    let k = kept_index(solves.iter().map(|(_, r)| r));
     let starts: Vec<StartResult> = solves
         .iter()
         .map(|(kind, r)| StartResult {
@@ -84,6 +93,100 @@ pub fn keep(solves: Vec<(StartKind, Record)>) -> Record {
     record.starts = starts;
     record.kept = Some(kind);
     record
+}
+
+/// The index of the record [`keep`] keeps: the converged one with the lowest Ψ̄ (the first of equal ones), else 0.
+fn kept_index<'a>(records: impl Iterator<Item = &'a Record>) -> usize {
+    let mut best: Option<(usize, f64)> = None;
+    for (i, r) in records.enumerate() {
+        if let Some(p) = r.converged_psi() {
+            if best.is_none_or(|(_, b)| p < b) {
+                best = Some((i, p));
+            }
+        }
+    }
+    best.map_or(0, |(i, _)| i)
+}
+
+/// Whether a sample's warm and cold starts disagree: one converged and the other not, or both converged with Ψ̄
+/// more than `rel` apart ([`relative_difference`]). A sample with one start does not disagree.
+fn disagree(solves: &[Solve], rel: f64) -> bool {
+    let psi = |k: StartKind| {
+        solves
+            .iter()
+            .find(|s| s.0 == k)
+            .map(|s| s.1.converged_psi())
+    };
+    match (psi(StartKind::Warm), psi(StartKind::Cold)) {
+        (Some(Some(a)), Some(Some(b))) => relative_difference(a, b) > rel,
+        (Some(a), Some(b)) => a.is_some() != b.is_some(),
+        _ => false,
+    }
+}
+
+/// One start's solve: its kind, record and converged state.
+type Solve = (StartKind, Record, Option<MicroState>);
+
+impl PlanRun<'_> {
+    /// `--starts all` on one chain: the forward pass (warm and cold starts, the chain continuing from its warm
+    /// equilibria), then the reversed pass (a sample whose starts [`disagree`] is also started from the kept
+    /// equilibrium of every step continuing it, latest first, so a lower branch found late propagates back up),
+    /// then the chain's unfinished records in order.
+    pub(super) fn chain_all(&self, steps: &[Step]) {
+        let id = |i: usize| &self.samples[steps[i].sample].id;
+        if (0..steps.len()).all(|i| self.done.contains(id(i))) {
+            return;
+        }
+        let rel = self.opts.disagreement.unwrap_or(DEFAULT_DISAGREEMENT);
+        let mut states: Vec<Option<MicroState>> = vec![None; steps.len()];
+        let mut solves: Vec<Vec<Solve>> = Vec::with_capacity(steps.len());
+        for (i, step) in steps.iter().enumerate() {
+            if self.stop.load(Ordering::Relaxed) {
+                return;
+            }
+            let sample = &self.samples[step.sample];
+            let (warm, ws) = self.solve(steps, step, &states, sample, false);
+            states[i] = ws.clone();
+            solves.push(if warm.start == SampleStart::Cold {
+                vec![(StartKind::Cold, warm, ws)]
+            } else {
+                let (cold, cs) = self.solve(steps, step, &states, sample, true);
+                vec![(StartKind::Warm, warm, ws), (StartKind::Cold, cold, cs)]
+            });
+        }
+        let mut kept: Vec<Option<MicroState>> = vec![None; steps.len()];
+        for i in (0..steps.len()).rev() {
+            if disagree(&solves[i], rel) {
+                let sample = &self.samples[steps[i].sample];
+                for j in (i + 1..steps.len()).filter(|&j| steps[j].from == Some(i)) {
+                    if let Some(s) = kept[j].as_ref() {
+                        let (r, st) = self.solve_from(sample, Some(s), SampleStart::Reverse, 0.0);
+                        solves[i].push((StartKind::Reverse, r, st));
+                    }
+                }
+            }
+            let k = kept_index(solves[i].iter().map(|s| &s.1));
+            kept[i] = solves[i][k].2.clone();
+        }
+        for (i, v) in solves.into_iter().enumerate() {
+            if self.done.contains(id(i)) {
+                self.replayed.fetch_add(1, Ordering::Relaxed);
+                continue;
+            }
+            if self
+                .opts
+                .limit
+                .is_some_and(|l| self.slots.fetch_add(1, Ordering::SeqCst) >= l)
+            {
+                self.stop.store(true, Ordering::Relaxed);
+                return;
+            }
+            let record = keep(v.into_iter().map(|(k, r, _)| (k, r)).collect());
+            if !self.write(&record) {
+                return;
+            }
+        }
+    }
 }
 
 /// A sample converged in both files whose Ψ̄ differ by more than the tolerance.
@@ -168,7 +271,6 @@ pub fn compare(a: &[Record], b: &[Record], rel: f64) -> Comparison {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sample::SampleStart;
 
     fn record(psi: Option<f64>, status: SampleStatus, steps: usize) -> Record {
         Record {

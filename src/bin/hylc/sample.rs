@@ -39,9 +39,13 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Predictor::Secant)]
     predictor: Predictor,
     /// starts of every sample (issue 19, item 1): warm (along the chain), or warm+cold (also from the reference
-    /// state, keeping the lowest converged Ψ̄; the record lists every start)
+    /// state, keeping the lowest converged Ψ̄; the record lists every start), or all (where warm and cold
+    /// disagree, also from the steps that continue the sample: the chain in reverse)
     #[arg(long, value_enum, default_value_t = Starts::Warm)]
     starts: Starts,
+    /// --starts all: relative difference of the warm and the cold Ψ̄ above which the reversed chain is tried
+    #[arg(long, default_value_t = hylc::sample::starts::DEFAULT_DISAGREEMENT)]
+    disagreement: f64,
     #[command(flatten)]
     solver: SolverArgs,
     #[command(flatten)]
@@ -63,6 +67,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         limit,
         predictor: a.predictor,
         starts: a.starts,
+        disagreement: Some(a.disagreement),
     };
     let bar = OnceLock::new();
     let progress = |done: usize, todo: usize| {
