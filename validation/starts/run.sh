@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Multi-start samples (issue 19, item 1; README-starts.md): the cost and the effect of `hylc sample --starts` on the
 # reduced plans of the original rib and honeycomb. Per pattern, the plan is sampled warm (today's default), cold
-# (`--cold`) and warm+cold; reported: wall time per mode, samples whose kept Ψ̄ changes against warm (count, by
+# (`--cold`), warm+cold and all (MODES); reported: wall time per mode, samples whose kept Ψ̄ changes against warm (count, by
 # how much), and the warm-first vs cold-first agreement (`hylc compare-samples`, relative tolerance $REL).
 #
 #   cargo build --release && validation/starts/run.sh           # needs ../shared/data/hylc2020 (skips without it)
@@ -18,6 +18,7 @@ OUT=${OUT:-out/starts}
 REL=${REL:-1e-6}
 PLAN=${PLAN:-reduced}
 PATTERNS=${PATTERNS:-rib honeycomb}
+MODES=${MODES:-warm cold warm+cold all}
 if [ ! -x "$HYLC" ]; then echo "$HYLC not found: cargo build --release first"; exit 2; fi
 for name in $PATTERNS; do
   case "$name" in
@@ -32,13 +33,15 @@ for name in $PATTERNS; do
   dir=$OUT/$name${SHARD:+-shard-${SHARD/\//-}}
   mkdir -p "$dir"
   echo "== $name ($pat), plan $PLAN${SHARD:+, shard $SHARD}, load $(cut -d' ' -f1-3 /proc/loadavg)"
-  for mode in warm cold warm+cold; do
+  for mode in $MODES; do
     f=$dir/$mode.jsonl
     if [ -f "$dir/$mode.done" ]; then echo "$mode: finished earlier"; continue; fi
     case $mode in
       warm) extra=() ;;
       cold) extra=(--cold) ;;
       warm+cold) extra=(--starts warm+cold) ;;
+      all) extra=(--starts all --disagreement "$REL") ;;
+      *) echo "unknown mode $mode (warm, cold, warm+cold, all)"; exit 2 ;;
     esac
     t0=$(date +%s.%N)
     "$HYLC" sample "$pat" --plan "$PLAN" --out "$f" ${SHARD:+--shard "$SHARD"} "${extra[@]}" \
@@ -52,8 +55,11 @@ for name in $PATTERNS; do
   done
   echo "-- warm-first vs cold-first (relative tolerance $REL):"
   "$HYLC" compare-samples "$dir/warm.jsonl" "$dir/cold.jsonl" --rel "$REL" | tail -n 1
-  echo "-- warm+cold against cold-first:"
-  "$HYLC" compare-samples "$dir/warm+cold.jsonl" "$dir/cold.jsonl" --rel "$REL" | tail -n 1
+  for mode in warm+cold all; do
+    [ -f "$dir/$mode.jsonl" ] || continue
+    echo "-- $mode against cold-first:"
+    "$HYLC" compare-samples "$dir/$mode.jsonl" "$dir/cold.jsonl" --rel "$REL" | tail -n 1
+  done
   python3 - "$dir" "$REL" <<'PY'
 import json, os, statistics, sys
 d, rel = sys.argv[1], float(sys.argv[2])
@@ -67,29 +73,33 @@ def wall(mode):
     return sum(float(x) for x in open(p)) if os.path.exists(p) else float("nan")
 def conv(r):
     return r["psi"] if r and r["status"] == "Converged" and r["psi"] is not None else None
-runs = {m: load(m) for m in ("warm", "cold", "warm+cold")}
+runs = {m: load(m) for m in ("warm", "cold", "warm+cold", "all")}
 print("| mode | samples | converged | wall (s) | Σ solve time (s) |")
 print("| --- | --- | --- | --- | --- |")
 for m, rs in runs.items():
     print(f"| {m} | {len(rs)} | {sum(conv(r) is not None for r in rs.values())} | {wall(m):.1f} | "
           f"{sum(r['time'] for r in rs.values()):.1f} |")
-warm, wc = runs["warm"], runs["warm+cold"]
-changed, gained = [], 0
-for i, r in wc.items():
-    a, b = conv(warm.get(i)), conv(r)
-    if a is None and b is not None:
-        gained += 1
-    elif a is not None and b is not None and abs(a - b) > rel * max(abs(a), abs(b)):
-        changed.append(((a - b) / abs(a) if a else float("inf"), a, b, r["z"]))
-kept = {}
-for r in wc.values():
-    kept[r.get("kept")] = kept.get(r.get("kept"), 0) + 1
-print(f"warm+cold against warm: {len(wc)} samples, kept {kept}; {len(changed)} converged in both change by more "
-      f"than {rel:g} relative, {gained} converge only with the cold start")
-if changed:
-    ch = sorted(c[0] for c in changed)
-    print(f"  relative decrease of Ψ̄: median {statistics.median(ch):.3g}, max {ch[-1]:.3g}")
-    for c in sorted(changed, reverse=True)[:5]:
-        print(f"  z = {c[3]}: warm {c[1]:.6g} → kept {c[2]:.6g} J/m² ({c[0]:.3g})")
+warm = runs["warm"]
+for mode in ("warm+cold", "all"):
+    wc = runs[mode]
+    if not wc:
+        continue
+    changed, gained = [], 0
+    for i, r in wc.items():
+        a, b = conv(warm.get(i)), conv(r)
+        if a is None and b is not None:
+            gained += 1
+        elif a is not None and b is not None and abs(a - b) > rel * max(abs(a), abs(b)):
+            changed.append(((a - b) / abs(a) if a else float("inf"), a, b, r["z"]))
+    kept = {}
+    for r in wc.values():
+        kept[r.get("kept")] = kept.get(r.get("kept"), 0) + 1
+    print(f"{mode} against warm: {len(wc)} samples, kept {kept}; {len(changed)} converged in both change by more "
+          f"than {rel:g} relative, {gained} converge only with another start")
+    if changed:
+        ch = sorted(c[0] for c in changed)
+        print(f"  relative decrease of Ψ̄: median {statistics.median(ch):.3g}, max {ch[-1]:.3g}")
+        for c in sorted(changed, reverse=True)[:5]:
+            print(f"  z = {c[3]}: warm {c[1]:.6g} → kept {c[2]:.6g} J/m² ({c[0]:.3g})")
 PY
 done
