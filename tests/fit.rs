@@ -52,6 +52,8 @@ fn write_samples(
             time: 0.0,
             start: SampleStart::Cold,
             problem: "0000000000000000".into(),
+            starts: vec![],
+            kept: None,
         };
         text += &serde_json::to_string(&r).unwrap();
         text.push('\n');

@@ -47,6 +47,8 @@ fn records(plan: &Plan, truth: &Material) -> Vec<Record> {
                 time: 0.0,
                 start: SampleStart::Cold,
                 problem: "0000000000000000".into(),
+                starts: vec![],
+                kept: None,
             }
         })
         .collect()

@@ -5,12 +5,14 @@
 pub mod plan;
 pub mod run;
 pub mod scene;
+pub mod starts;
 
 pub use plan::{sample_range, Chain, InPlaneGrid, Plan, PlanError, Sample, Step};
 pub use run::{
     merge, parse_shard, read_samples, run_plan, run_plan_with, Record, RunOptions, RunSummary,
     SampleStart, SampleStatus,
 };
+pub use starts::{compare, Comparison, Disagreement, StartKind, StartResult, Starts};
 
 use std::path::PathBuf;
 
@@ -39,4 +41,10 @@ pub enum SampleError {
     /// A shard that is not `k/n` with 0 ≤ k < n.
     #[error("--shard: expected k/n with 0 ≤ k < n, got {0:?}")]
     Shard(String),
+    /// `--starts` other than `warm` with `--cold` (the cold start is one of the starts).
+    #[error("--starts {0} with --cold: --cold solves from the reference state only; drop --cold")]
+    Starts(String),
+    /// A disagreement tolerance of `--starts all` that is not a finite number ≥ 0.
+    #[error("--disagreement: expected a finite relative tolerance ≥ 0, got {0}")]
+    Disagreement(f64),
 }

@@ -8,6 +8,8 @@
 //!   converged too, or with the tangent predictor [`MicroProblem::predict_tangent`] from the step it continues
 //!   ([`RunOptions::predictor`]); `cold` starts every sample from the reference state. A record's `time` includes
 //!   the predictor's.
+//! - Multi-start ([`RunOptions::starts`], [`super::starts`]; issue 19, item 1): `warm+cold` also solves every
+//!   sample from the reference state and writes the lowest converged Ψ̄, listing every start.
 //! - The sample file is JSON lines, append-only: one [`Record`] per sample, written as one `write` call of the
 //!   full line and then synced to disk, so an interrupted run loses at most the sample in flight.
 //! - Resume: ids already in the file are skipped (a truncated last line is cut off first). Skipped samples that a
@@ -18,6 +20,7 @@
 //!   duplicate ids.
 
 use super::plan::{fnv1a64, Plan, Sample, Step};
+use super::starts::{keep, StartKind, StartResult, Starts};
 use super::SampleError;
 use crate::micro::envelope::strain_derivatives;
 use crate::micro::{MacroStrain, MicroProblem, MicroState, Predictor, Status};
@@ -61,6 +64,13 @@ pub struct Record {
     pub start: SampleStart,
     /// Hash of (pattern, yarn parameters, solver settings), 16 hex digits ([`problem_hash`]).
     pub problem: String,
+    /// Every start of a multi-start sample ([`RunOptions::starts`]; issue 19, item 1); empty (omitted) when the
+    /// sample was solved from one start.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub starts: Vec<StartResult>,
+    /// Which of `starts` the record's `psi`, `stress`, `status` and `steps` are (omitted with one start).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kept: Option<StartKind>,
 }
 
 impl Record {
@@ -114,6 +124,8 @@ pub enum SampleStart {
     Predicted,
     /// From the tangent predictor y* + (dy*/dz)·Δz of the step it continues.
     Tangent,
+    /// From the kept equilibrium of a step that continues it (the reversed chain; `--starts all`).
+    Reverse,
 }
 
 /// Options of [`run_plan`].
@@ -127,6 +139,11 @@ pub struct RunOptions {
     pub limit: Option<usize>,
     /// The predictor of warm starts.
     pub predictor: Predictor,
+    /// The starts of every sample (issue 19, item 1; [`super::starts`]); not with `cold`.
+    pub starts: Starts,
+    /// `Starts::All`: the relative difference of the warm and the cold Ψ̄ above which the reversed chain is tried
+    /// too ([`super::starts::DEFAULT_DISAGREEMENT`] when `None`).
+    pub disagreement: Option<f64>,
 }
 
 /// What a run did.
@@ -248,6 +265,12 @@ pub fn run_plan_with(
 ) -> Result<RunSummary, SampleError> {
     let t0 = Instant::now();
     plan.validate()?;
+    if opts.cold && opts.starts != Starts::Warm {
+        return Err(SampleError::Starts(opts.starts.to_string()));
+    }
+    if let Some(d) = opts.disagreement.filter(|d| !(d.is_finite() && *d >= 0.0)) {
+        return Err(SampleError::Disagreement(d));
+    }
     let hash = problem_hash(problem);
     let existing = read_samples(out, true)?;
     if let Some(r) = existing.iter().find(|r| r.problem != hash) {
@@ -320,12 +343,12 @@ pub fn run_plan_with(
 }
 
 /// The shared state of one [`run_plan_with`]: the inputs, the sample file and the counters the chains update.
-struct PlanRun<'a> {
+pub(super) struct PlanRun<'a> {
     problem: &'a MicroProblem,
-    samples: &'a [Sample],
+    pub(super) samples: &'a [Sample],
     /// Ids already in the sample file.
-    done: &'a HashSet<String>,
-    opts: &'a RunOptions,
+    pub(super) done: &'a HashSet<String>,
+    pub(super) opts: &'a RunOptions,
     hash: &'a str,
     out: &'a Path,
     file: Mutex<File>,
@@ -334,10 +357,10 @@ struct PlanRun<'a> {
     progress: &'a (dyn Fn(usize, usize) + Sync),
     written: AtomicUsize,
     /// Records claimed against `opts.limit`.
-    slots: AtomicUsize,
+    pub(super) slots: AtomicUsize,
     converged: AtomicUsize,
-    replayed: AtomicUsize,
-    stop: AtomicBool,
+    pub(super) replayed: AtomicUsize,
+    pub(super) stop: AtomicBool,
     failure: Mutex<Option<SampleError>>,
 }
 
@@ -345,6 +368,9 @@ impl PlanRun<'_> {
     /// One chain, in order: its unfinished steps and (warm) every step they continue from, each started from the
     /// nearest converged step up the chain.
     fn chain(&self, steps: &[Step]) {
+        if self.opts.starts == Starts::All {
+            return self.chain_all(steps);
+        }
         let mut need: Vec<bool> = steps
             .iter()
             .map(|s| !self.done.contains(&self.samples[s.sample].id))
@@ -374,8 +400,20 @@ impl PlanRun<'_> {
                 self.stop.store(true, Ordering::Relaxed);
                 break;
             }
-            let (record, state) = self.solve(steps, step, &states, sample);
+            let (record, state) = self.solve(steps, step, &states, sample, self.opts.cold);
             states[i] = state;
+            // warm+cold: the cold start too, unless the chain's start was cold already (no converged step up
+            // the chain); only the record changes, the chain continues from its warm equilibria
+            let record = match self.opts.starts {
+                Starts::Warm | Starts::All => record,
+                Starts::WarmCold if record.start == SampleStart::Cold => {
+                    keep(vec![(StartKind::Cold, record)])
+                }
+                Starts::WarmCold => {
+                    let (cold, _) = self.solve(steps, step, &states, sample, true);
+                    keep(vec![(StartKind::Warm, record), (StartKind::Cold, cold)])
+                }
+            };
             if write {
                 if !self.write(&record) {
                     break;
@@ -387,17 +425,18 @@ impl PlanRun<'_> {
     }
 
     /// Solve one step from its start (secant prediction, warm or cold); the record, and the state when converged.
-    fn solve(
+    pub(super) fn solve(
         &self,
         steps: &[Step],
         step: &Step,
         states: &[Option<MicroState>],
         sample: &Sample,
+        cold: bool,
     ) -> (Record, Option<MicroState>) {
         let problem = self.problem;
         let strain = MacroStrain(sample.z);
         // the nearest converged step up the chain, and its own converged predecessor
-        let mut a = if self.opts.cold { None } else { step.from };
+        let mut a = if cold { None } else { step.from };
         while let Some(k) = a {
             if states[k].is_some() {
                 break;
@@ -433,6 +472,20 @@ impl PlanRun<'_> {
         } else {
             None
         };
+        self.solve_from(sample, start, how, predict_time)
+    }
+
+    /// Solve one sample from `start` (the reference state when `None`), `how` naming the start; the record, and
+    /// the state when converged. `predict_time` (s) is added to the record's time.
+    pub(super) fn solve_from(
+        &self,
+        sample: &Sample,
+        start: Option<&MicroState>,
+        how: SampleStart,
+        predict_time: f64,
+    ) -> (Record, Option<MicroState>) {
+        let problem = self.problem;
+        let strain = MacroStrain(sample.z);
         let t = Instant::now();
         let mut record = Record {
             id: sample.id.clone(),
@@ -447,6 +500,8 @@ impl PlanRun<'_> {
             time: 0.0,
             start: how,
             problem: self.hash.to_string(),
+            starts: vec![],
+            kept: None,
         };
         match problem.solve(&strain, start) {
             Ok(sol) => {
@@ -471,7 +526,7 @@ impl PlanRun<'_> {
 
     /// Append a record as a single write of the full line, then sync it to disk; count it and report progress.
     /// False (and the run stops) when the file cannot be written.
-    fn write(&self, record: &Record) -> bool {
+    pub(super) fn write(&self, record: &Record) -> bool {
         let line = record_line(record);
         let result = match self.file.lock() {
             Ok(mut f) => f
@@ -599,6 +654,8 @@ mod tests {
             time: 0.01,
             start: SampleStart::Cold,
             problem: "0".into(),
+            starts: vec![],
+            kept: None,
         };
         let line = serde_json::to_string(&r).unwrap();
         std::fs::write(&path, format!("{line}\n{}", &line[..20])).unwrap();
@@ -629,6 +686,8 @@ mod tests {
             time: 0.01,
             start: SampleStart::Cold,
             problem: "0".into(),
+            starts: vec![],
+            kept: None,
         };
         std::fs::write(&path, format!("\u{feff}{}", record_line(&r))).unwrap();
         assert_eq!(read_samples(&path, true).unwrap(), vec![r.clone()]);

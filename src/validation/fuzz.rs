@@ -282,6 +282,8 @@ fn sample_seed() -> String {
             time: 0.01,
             start: SampleStart::Warm,
             problem: "0123456789abcdef".into(),
+            starts: vec![],
+            kept: None,
         };
         text += &serde_json::to_string(&r).unwrap_or_default();
         text.push('\n');

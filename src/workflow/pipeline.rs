@@ -385,6 +385,8 @@ fn stage_sample(args: &RunConfig, dir: &Path, log: &mut Log) -> Result<Sampled, 
         shard: None,
         limit: None,
         predictor: Default::default(),
+        starts: Default::default(),
+        disagreement: None,
     };
     let sp = log.sample(&problem, &plan, &samples, &opts)?;
     let holdout = dir.join("holdout.jsonl");

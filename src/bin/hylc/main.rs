@@ -5,6 +5,7 @@
 mod args;
 mod calibrate;
 mod check_derivatives;
+mod compare_samples;
 mod fit;
 mod fuzz;
 mod generate;
@@ -47,6 +48,7 @@ enum Command {
     Solve(solve::Args),
     Sample(sample::Args),
     Merge(merge::Args),
+    CompareSamples(compare_samples::Args),
     ScenePlan(scene_plan::Args),
     Plan(plan::Args),
     Fit(fit::Args),
@@ -100,6 +102,7 @@ fn main() -> ExitCode {
         Command::Solve(a) => solve::run(a),
         Command::Sample(a) => sample::run(a),
         Command::Merge(a) => merge::run(a),
+        Command::CompareSamples(a) => compare_samples::run(a),
         Command::ScenePlan(a) => scene_plan::run(a),
         Command::Plan(a) => plan::run(a),
         Command::Fit(a) => fit::run(a),

@@ -6,7 +6,7 @@ use crate::printer::sample_bar;
 use crate::strain::load_pattern_noted;
 use hylc::micro::MicroProblem;
 use hylc::micro::Predictor;
-use hylc::sample::{parse_shard, run_plan_with, RunOptions};
+use hylc::sample::{parse_shard, run_plan_with, RunOptions, Starts};
 use hylc::workflow::inputs::load_plan;
 use hylc::workflow::sidecar::write_meta;
 use std::path::PathBuf;
@@ -38,6 +38,14 @@ pub struct Args {
     /// (y* + dy*/dz Δz from the previous one) or none (the previous equilibrium itself)
     #[arg(long, value_enum, default_value_t = Predictor::Secant)]
     predictor: Predictor,
+    /// starts of every sample (issue 19, item 1): warm (along the chain), or warm+cold (also from the reference
+    /// state, keeping the lowest converged Ψ̄; the record lists every start), or all (where warm and cold
+    /// disagree, also from the steps that continue the sample: the chain in reverse)
+    #[arg(long, value_enum, default_value_t = Starts::Warm)]
+    starts: Starts,
+    /// --starts all: relative difference of the warm and the cold Ψ̄ above which the reversed chain is tried
+    #[arg(long, default_value_t = hylc::sample::starts::DEFAULT_DISAGREEMENT)]
+    disagreement: f64,
     #[command(flatten)]
     solver: SolverArgs,
     #[command(flatten)]
@@ -58,6 +66,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         shard,
         limit,
         predictor: a.predictor,
+        starts: a.starts,
+        disagreement: Some(a.disagreement),
     };
     let bar = OnceLock::new();
     let progress = |done: usize, todo: usize| {

@@ -1,0 +1,343 @@
+//! Multi-start samples (issue 19, item 1, "A defined Ψ̄"): `--starts warm+cold` keeps the lowest converged Ψ̄ of
+//! the warm and the cold start, records every start and the one kept, leaves the warm chain as it was, and gives
+//! the same records resumed or sharded; `hylc compare-samples` lists the samples where two files disagree.
+
+mod common;
+
+use common::cli_error;
+use hylc::generate::default_pattern;
+use hylc::micro::{MicroProblem, SolverOptions};
+use hylc::rod::YarnMaterial;
+use hylc::sample::{
+    compare, merge, read_samples, run_plan, Plan, Record, RunOptions, SampleStart, StartKind,
+    Starts,
+};
+use hylc::strain::StrainComponent::{Sa, Sx, Sy, II00};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn problem() -> MicroProblem {
+    let p = default_pattern("plain").expect("plain pattern");
+    MicroProblem::new(p, &YarnMaterial::default(), SolverOptions::default())
+}
+
+/// A tiny plan: 1D counts 4, 3×3 grids on two pairs (38 samples).
+fn tiny_plan() -> Plan {
+    let mut p = Plan::reduced();
+    p.count_1d = 4;
+    p.count_2d = 3;
+    p.pairs = vec![[Sx, Sa], [Sy, II00]];
+    p
+}
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hylc-starts-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d
+}
+
+/// The records by id with the wall time zeroed (the only field that may differ between runs).
+fn by_id(records: Vec<Record>) -> BTreeMap<String, Record> {
+    records
+        .into_iter()
+        .map(|mut r| {
+            r.time = 0.0;
+            (r.id.clone(), r)
+        })
+        .collect()
+}
+
+fn run(
+    problem: &MicroProblem,
+    plan: &Plan,
+    out: &Path,
+    opts: RunOptions,
+) -> BTreeMap<String, Record> {
+    run_plan(problem, plan, out, &opts).expect("run");
+    by_id(read_samples(out, false).expect("read"))
+}
+
+fn both() -> RunOptions {
+    RunOptions {
+        starts: Starts::WarmCold,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn warm_and_cold_keeps_the_lowest_converged_start() {
+    let d = dir("keep");
+    let (problem, plan) = (problem(), tiny_plan());
+    let warm = run(
+        &problem,
+        &plan,
+        &d.join("warm.jsonl"),
+        RunOptions::default(),
+    );
+    let cold_opts = RunOptions {
+        cold: true,
+        ..Default::default()
+    };
+    let cold = run(&problem, &plan, &d.join("cold.jsonl"), cold_opts);
+    let wc = run(&problem, &plan, &d.join("wc.jsonl"), both());
+    assert_eq!(wc.len(), plan.len());
+
+    // warm mode writes the records of earlier versions: no `starts`, no `kept`
+    let text = std::fs::read_to_string(d.join("warm.jsonl")).unwrap();
+    assert!(!text.contains("\"starts\"") && !text.contains("\"kept\""));
+    assert!(warm
+        .values()
+        .all(|r| r.starts.is_empty() && r.kept.is_none()));
+
+    let mut two_starts = 0;
+    for (id, r) in &wc {
+        let (w, c) = (&warm[id], &cold[id]);
+        // every start is recorded; the warm start is the warm run's solve and the cold one the cold run's
+        let kinds: Vec<StartKind> = r.starts.iter().map(|s| s.kind).collect();
+        if w.start == SampleStart::Cold {
+            assert_eq!(kinds, vec![StartKind::Cold], "{id}");
+        } else {
+            two_starts += 1;
+            assert_eq!(kinds, vec![StartKind::Warm, StartKind::Cold], "{id}");
+            let s = &r.starts[0];
+            assert_eq!(
+                s.psi.map(f64::to_bits),
+                w.converged_psi().map(f64::to_bits),
+                "{id}"
+            );
+            assert_eq!((s.status, s.steps), (w.status, w.steps), "{id}");
+        }
+        let s = r.starts.last().unwrap();
+        assert_eq!(
+            s.psi.map(f64::to_bits),
+            c.converged_psi().map(f64::to_bits),
+            "{id}"
+        );
+        assert_eq!((s.status, s.steps), (c.status, c.steps), "{id}");
+        // the kept Ψ̄ is ≤ the warm-only and the cold-only Ψ̄ wherever they converged
+        let kept = r.converged_psi();
+        for other in [w.converged_psi(), c.converged_psi()].into_iter().flatten() {
+            assert!(
+                kept.is_some_and(|k| k <= other),
+                "{id}: kept {kept:?} > {other}"
+            );
+        }
+        // `kept` names the start with the minimum, and the main fields are that start's
+        let k = r.kept.expect("kept");
+        let ks = r.starts.iter().find(|s| s.kind == k).unwrap();
+        assert_eq!(ks.psi.map(f64::to_bits), kept.map(f64::to_bits), "{id}");
+        assert_eq!((ks.status, ks.steps), (r.status, r.steps), "{id}");
+        let min = r
+            .starts
+            .iter()
+            .filter_map(|s| s.psi)
+            .fold(f64::INFINITY, f64::min);
+        assert_eq!(
+            kept.map(f64::to_bits),
+            Some(min.to_bits()).filter(|_| min.is_finite())
+        );
+        let source = if k == StartKind::Cold { c } else { w };
+        assert_eq!(r.stress, source.stress, "{id}");
+    }
+    assert!(two_starts > 0);
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn warm_and_cold_resumed_and_sharded_give_the_same_records() {
+    let d = dir("resume");
+    let (problem, plan) = (problem(), tiny_plan());
+    let full = run(&problem, &plan, &d.join("full.jsonl"), both());
+    // resume after a cut in the middle of a line
+    let text = std::fs::read(d.join("full.jsonl")).unwrap();
+    let cut = d.join("cut.jsonl");
+    std::fs::write(&cut, &text[..text.len() / 2 + 7]).unwrap();
+    let before = read_samples(&cut, false).unwrap().len();
+    assert!(before > 0 && before < plan.len());
+    assert_eq!(run(&problem, &plan, &cut, both()), full);
+    assert_eq!(read_samples(&cut, false).unwrap().len(), plan.len());
+    // two shards merged
+    let files: Vec<PathBuf> = (0..2).map(|k| d.join(format!("s{k}.jsonl"))).collect();
+    for (k, f) in files.iter().enumerate() {
+        let opts = RunOptions {
+            shard: Some((k, 2)),
+            ..both()
+        };
+        run(&problem, &plan, f, opts);
+    }
+    let m = d.join("merged.jsonl");
+    merge(&m, &[files[0].as_path(), files[1].as_path()]).unwrap();
+    assert_eq!(by_id(read_samples(&m, false).unwrap()), full);
+    // a file compared with itself agrees everywhere
+    let rs = read_samples(&m, false).unwrap();
+    let c = compare(&rs, &rs, 0.0);
+    assert_eq!(
+        (c.common, c.agree, c.differ.len()),
+        (plan.len(), c.both_converged, 0)
+    );
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn all_tries_the_reversed_chain_where_warm_and_cold_disagree() {
+    let d = dir("all");
+    let (problem, plan) = (problem(), tiny_plan());
+    let all_opts = || RunOptions {
+        starts: Starts::All,
+        ..Default::default()
+    };
+    let wc = run(&problem, &plan, &d.join("wc.jsonl"), both());
+    let all = run(&problem, &plan, &d.join("all.jsonl"), all_opts());
+    assert_eq!(all.len(), plan.len());
+    let disagree = |r: &Record| {
+        let (w, c) = (r.starts.first().unwrap(), r.starts.last().unwrap());
+        r.starts.len() == 2
+            && match (w.psi, c.psi) {
+                (Some(a), Some(b)) => (a - b).abs() > 1e-6 * a.abs().max(b.abs()),
+                (a, b) => a.is_some() != b.is_some(),
+            }
+    };
+    let mut reversed = 0;
+    for (id, r) in &all {
+        let q = &wc[id];
+        // the forward pass is warm+cold's; reversed starts only where warm and cold disagree
+        assert_eq!(r.starts[..q.starts.len()], q.starts[..], "{id}");
+        let extra = &r.starts[q.starts.len()..];
+        assert!(extra.iter().all(|s| s.kind == StartKind::Reverse), "{id}");
+        if !disagree(q) {
+            assert!(extra.is_empty(), "{id}");
+        }
+        reversed += extra.len();
+        // the kept Ψ̄ is ≤ warm+cold's, and the minimum of the starts
+        if let Some(p) = q.converged_psi() {
+            assert!(r.converged_psi().is_some_and(|k| k <= p), "{id}");
+        }
+        let min = r
+            .starts
+            .iter()
+            .filter_map(|s| s.psi)
+            .fold(f64::INFINITY, f64::min);
+        if min.is_finite() {
+            assert_eq!(
+                r.converged_psi().map(f64::to_bits),
+                Some(min.to_bits()),
+                "{id}"
+            );
+        }
+    }
+    assert!(
+        wc.values().any(disagree),
+        "the tiny plan has samples where warm and cold disagree"
+    );
+    assert!(reversed > 0);
+    // resumed and sharded: the same records
+    let text = std::fs::read(d.join("all.jsonl")).unwrap();
+    let cut = d.join("cut.jsonl");
+    std::fs::write(&cut, &text[..text.len() / 2 + 7]).unwrap();
+    assert_eq!(run(&problem, &plan, &cut, all_opts()), all);
+    let files: Vec<PathBuf> = (0..2).map(|k| d.join(format!("s{k}.jsonl"))).collect();
+    for (k, f) in files.iter().enumerate() {
+        let opts = RunOptions {
+            shard: Some((k, 2)),
+            ..all_opts()
+        };
+        run(&problem, &plan, f, opts);
+    }
+    let m = d.join("merged.jsonl");
+    merge(&m, &[files[0].as_path(), files[1].as_path()]).unwrap();
+    assert_eq!(by_id(read_samples(&m, false).unwrap()), all);
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn cli_starts_and_compare_samples() {
+    let d = dir("cli");
+    let exe = env!("CARGO_BIN_EXE_hylc");
+    let mut plan = tiny_plan();
+    plan.pairs = vec![[Sx, Sa]];
+    let plan_file = d.join("plan.json");
+    std::fs::write(&plan_file, serde_json::to_string(&plan).unwrap()).unwrap();
+    let pf = plan_file.display().to_string();
+    let o = d.join("x.jsonl").display().to_string();
+    let err = cli_error(&[
+        "sample", "plain", "--plan", &pf, "--out", &o, "--starts", "hot",
+    ]);
+    assert!(err.contains("--starts") && err.contains("hot"), "{err}");
+    let err = cli_error(&[
+        "sample",
+        "plain",
+        "--plan",
+        &pf,
+        "--out",
+        &o,
+        "--starts",
+        "warm+cold",
+        "--cold",
+    ]);
+    assert!(err.contains("--starts warm+cold with --cold"), "{err}");
+    let err = cli_error(&[
+        "sample",
+        "plain",
+        "--plan",
+        &pf,
+        "--out",
+        &o,
+        "--starts",
+        "all",
+        "--disagreement=-1",
+    ]);
+    assert!(err.contains("--disagreement"), "{err}");
+
+    let sample = |out: &Path, extra: &[&str]| {
+        let o = out.display().to_string();
+        let mut args = vec!["sample", "plain", "--plan", &pf, "--out", &o];
+        args.extend(extra);
+        let s = Command::new(exe).args(&args).output().unwrap();
+        assert!(matches!(s.status.code(), Some(0 | 3)), "{s:?}");
+    };
+    let (w, c, wc) = (d.join("w.jsonl"), d.join("c.jsonl"), d.join("wc.jsonl"));
+    sample(&w, &[]);
+    sample(&c, &["--cold"]);
+    sample(&wc, &["--starts", "warm+cold"]);
+    let text = std::fs::read_to_string(&wc).unwrap();
+    assert!(text
+        .lines()
+        .all(|l| l.contains("\"starts\":[") && l.contains("\"kept\":\"")));
+
+    // compare-samples: the library's counts, one row per disagreement, exit 3 when there is any
+    let (rw, rc) = (
+        read_samples(&w, false).unwrap(),
+        read_samples(&c, false).unwrap(),
+    );
+    let expect = compare(&rw, &rc, 1e-6);
+    let out = Command::new(exe)
+        .args([
+            "compare-samples",
+            &w.display().to_string(),
+            &c.display().to_string(),
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(if expect.differ.is_empty() { 0 } else { 3 })
+    );
+    let rows = stdout
+        .lines()
+        .filter(|l| l.split('\t').count() == 6)
+        .count();
+    let header = usize::from(!expect.differ.is_empty());
+    assert_eq!(rows, expect.differ.len() + header, "{stdout}");
+    let last = stdout.lines().last().unwrap();
+    assert!(
+        last.starts_with(&format!("{} common samples", plan.len()))
+            && last.contains(&format!("{} differ", expect.differ.len())),
+        "{last}"
+    );
+    let err = cli_error(&["compare-samples", &o, &o]);
+    assert!(err.contains("no such sample file"), "{err}");
+    std::fs::remove_dir_all(&d).ok();
+}
