@@ -5,58 +5,20 @@
 mod common;
 
 use common::cli_error;
+use common::sampling::{self, by_id, problem, run, tiny_plan};
 use hylc::generate::default_pattern;
 use hylc::micro::{MicroProblem, SolverOptions};
 use hylc::rod::YarnMaterial;
 use hylc::sample::{
     merge, read_samples, run_plan, run_plan_with, Plan, Record, RunOptions, SampleStart,
 };
-use hylc::strain::StrainComponent::{Sa, Sx, Sy, II00};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-fn problem() -> MicroProblem {
-    let p = default_pattern("plain").expect("plain pattern");
-    MicroProblem::new(p, &YarnMaterial::default(), SolverOptions::default())
-}
-
-/// A tiny plan: 1D counts 4, 3×3 grids on two pairs (38 samples).
-fn tiny_plan() -> Plan {
-    let mut p = Plan::reduced();
-    p.count_1d = 4;
-    p.count_2d = 3;
-    p.pairs = vec![[Sx, Sa], [Sy, II00]];
-    p
-}
-
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hylc-sample-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d
-}
-
-/// The records by id with the wall time zeroed (the only field that may differ between runs).
-fn by_id(records: Vec<Record>) -> BTreeMap<String, Record> {
-    records
-        .into_iter()
-        .map(|mut r| {
-            r.time = 0.0;
-            (r.id.clone(), r)
-        })
-        .collect()
-}
-
-fn run(
-    problem: &MicroProblem,
-    plan: &Plan,
-    out: &Path,
-    opts: RunOptions,
-) -> BTreeMap<String, Record> {
-    run_plan(problem, plan, out, &opts).expect("run");
-    by_id(read_samples(out, false).expect("read"))
+    sampling::dir("sample", name)
 }
 
 fn assert_same(a: &BTreeMap<String, Record>, b: &BTreeMap<String, Record>) {

@@ -5,58 +5,14 @@
 mod common;
 
 use common::cli_error;
-use hylc::generate::default_pattern;
-use hylc::micro::{MicroProblem, SolverOptions};
-use hylc::rod::YarnMaterial;
-use hylc::sample::{
-    compare, merge, read_samples, run_plan, Plan, Record, RunOptions, SampleStart, StartKind,
-    Starts,
-};
-use hylc::strain::StrainComponent::{Sa, Sx, Sy, II00};
-use std::collections::BTreeMap;
+use common::sampling::{self, assert_resumed_and_sharded_equal, problem, run, tiny_plan};
+use hylc::sample::{compare, read_samples, Record, RunOptions, SampleStart, StartKind, Starts};
+use hylc::strain::StrainComponent::{Sa, Sx};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn problem() -> MicroProblem {
-    let p = default_pattern("plain").expect("plain pattern");
-    MicroProblem::new(p, &YarnMaterial::default(), SolverOptions::default())
-}
-
-/// A tiny plan: 1D counts 4, 3×3 grids on two pairs (38 samples).
-fn tiny_plan() -> Plan {
-    let mut p = Plan::reduced();
-    p.count_1d = 4;
-    p.count_2d = 3;
-    p.pairs = vec![[Sx, Sa], [Sy, II00]];
-    p
-}
-
 fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hylc-starts-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d
-}
-
-/// The records by id with the wall time zeroed (the only field that may differ between runs).
-fn by_id(records: Vec<Record>) -> BTreeMap<String, Record> {
-    records
-        .into_iter()
-        .map(|mut r| {
-            r.time = 0.0;
-            (r.id.clone(), r)
-        })
-        .collect()
-}
-
-fn run(
-    problem: &MicroProblem,
-    plan: &Plan,
-    out: &Path,
-    opts: RunOptions,
-) -> BTreeMap<String, Record> {
-    run_plan(problem, plan, out, &opts).expect("run");
-    by_id(read_samples(out, false).expect("read"))
+    sampling::dir("starts", name)
 }
 
 fn both() -> RunOptions {
@@ -150,28 +106,10 @@ fn warm_and_cold_resumed_and_sharded_give_the_same_records() {
     let d = dir("resume");
     let (problem, plan) = (problem(), tiny_plan());
     let full = run(&problem, &plan, &d.join("full.jsonl"), both());
-    // resume after a cut in the middle of a line
-    let text = std::fs::read(d.join("full.jsonl")).unwrap();
-    let cut = d.join("cut.jsonl");
-    std::fs::write(&cut, &text[..text.len() / 2 + 7]).unwrap();
-    let before = read_samples(&cut, false).unwrap().len();
-    assert!(before > 0 && before < plan.len());
-    assert_eq!(run(&problem, &plan, &cut, both()), full);
-    assert_eq!(read_samples(&cut, false).unwrap().len(), plan.len());
-    // two shards merged
-    let files: Vec<PathBuf> = (0..2).map(|k| d.join(format!("s{k}.jsonl"))).collect();
-    for (k, f) in files.iter().enumerate() {
-        let opts = RunOptions {
-            shard: Some((k, 2)),
-            ..both()
-        };
-        run(&problem, &plan, f, opts);
-    }
-    let m = d.join("merged.jsonl");
-    merge(&m, &[files[0].as_path(), files[1].as_path()]).unwrap();
-    assert_eq!(by_id(read_samples(&m, false).unwrap()), full);
+    assert_eq!(full.len(), plan.len());
+    assert_resumed_and_sharded_equal(&problem, &plan, &d, &d.join("full.jsonl"), &both());
     // a file compared with itself agrees everywhere
-    let rs = read_samples(&m, false).unwrap();
+    let rs = read_samples(&d.join("full.jsonl"), false).unwrap();
     let c = compare(&rs, &rs, 0.0);
     assert_eq!(
         (c.common, c.agree, c.differ.len()),
@@ -233,21 +171,7 @@ fn all_tries_the_reversed_chain_where_warm_and_cold_disagree() {
     );
     assert!(reversed > 0);
     // resumed and sharded: the same records
-    let text = std::fs::read(d.join("all.jsonl")).unwrap();
-    let cut = d.join("cut.jsonl");
-    std::fs::write(&cut, &text[..text.len() / 2 + 7]).unwrap();
-    assert_eq!(run(&problem, &plan, &cut, all_opts()), all);
-    let files: Vec<PathBuf> = (0..2).map(|k| d.join(format!("s{k}.jsonl"))).collect();
-    for (k, f) in files.iter().enumerate() {
-        let opts = RunOptions {
-            shard: Some((k, 2)),
-            ..all_opts()
-        };
-        run(&problem, &plan, f, opts);
-    }
-    let m = d.join("merged.jsonl");
-    merge(&m, &[files[0].as_path(), files[1].as_path()]).unwrap();
-    assert_eq!(by_id(read_samples(&m, false).unwrap()), all);
+    assert_resumed_and_sharded_equal(&problem, &plan, &d, &d.join("all.jsonl"), &all_opts());
     std::fs::remove_dir_all(&d).ok();
 }
 

@@ -3,6 +3,8 @@
 
 use std::path::PathBuf;
 
+pub mod sampling;
+
 /// `../shared`, or `None` after printing why the calling test skips.
 pub fn shared_or_skip(test: &str) -> Option<PathBuf> {
     match hylc::shared_dir() {
