@@ -55,7 +55,7 @@ impl Differentiable for PairCheck {
             self.rest[0],
             self.rest[1],
             self.kernel.stiffness(),
-            self.kernel.radius(),
+            D::from(self.kernel.radius()),
             self.kernel.rule(),
         )
     }
@@ -158,30 +158,15 @@ impl Differentiable for PairRadiusCheck {
         self.radius
     }
     fn reference<D: Real>(&self, x: &[D]) -> D {
-        // E = k_c l̄_a l̄_b Σ_p Σ_q w_p w_q f(‖x_a(s_p) − x_b(s_q)‖/(2r)), f(ρ) = 1/ρ² + ρ² − 2 for ρ < 1
-        let rule = crate::contact::GaussLegendre::new(self.order);
-        let radius = x[12].clone();
-        let point = |start: usize, s: f64| -> [D; 3] {
-            std::array::from_fn(|i| x[start + i].clone() * (1.0 - s) + x[start + 3 + i].clone() * s)
-        };
-        let mut sum = D::from(0.0);
-        for (&sp, &wp) in rule.nodes().iter().zip(rule.weights()) {
-            let xa = point(0, sp);
-            for (&sq, &wq) in rule.nodes().iter().zip(rule.weights()) {
-                let xb = point(6, sq);
-                let mut dist2 = D::from(0.0);
-                for i in 0..3 {
-                    let di = xa[i].clone() - xb[i].clone();
-                    dist2 += di.clone() * di;
-                }
-                let rho = dist2.sqrt() / (radius.clone() * 2.0);
-                if rho.re() < 1.0 {
-                    let rho2 = rho.clone() * rho;
-                    sum += (rho2.recip() + rho2 - 2.0) * (wp * wq);
-                }
-            }
-        }
-        sum * (self.stiffness * self.rest[0] * self.rest[1])
+        // the pair energy with the radius x[12] as a variable
+        pair_energy_reference(
+            &x[..12],
+            self.rest[0],
+            self.rest[1],
+            self.stiffness,
+            x[12].clone(),
+            &crate::contact::GaussLegendre::new(self.order),
+        )
     }
     fn fast(&self, x: &[f64]) -> Vgh {
         let p = points(x);

@@ -213,7 +213,7 @@ pub(crate) fn reference_energy<D: Real>(
             p.edges[pair.a].rest_length,
             p.edges[pair.b].rest_length,
             m.contact_stiffness,
-            tile.contact_radius,
+            D::from(tile.contact_radius),
             rule,
         );
     }

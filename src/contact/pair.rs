@@ -400,13 +400,14 @@ pub struct PairRadiusDerivatives {
 
 /// The reference twin of [`PairKernel::value`], generic over the scalar, written plainly as the formula:
 /// E = k_c l̄_a l̄_b Σ_p Σ_q w_p w_q f(‖x_a(s_p) − x_b(s_q)‖/(2r)), f(ρ) = 1/ρ² + ρ² − 2 for ρ < 1 (decided on the
-/// real part), with `x` the 12 coordinates (x_a0, x_a1, x_b0, x_b1). No early reject, no overlap guard.
+/// real part), with `x` the 12 coordinates (x_a0, x_a1, x_b0, x_b1) and the radius r a scalar of the same kind
+/// (the harness differentiates in r too). No early reject, no overlap guard.
 pub fn pair_energy_reference<D: Real>(
     x: &[D],
     rest_a: f64,
     rest_b: f64,
     stiffness: f64,
-    radius: f64,
+    radius: D,
     rule: &GaussLegendre,
 ) -> D {
     let point = |start: usize, s: f64| -> [D; 3] {
@@ -422,7 +423,7 @@ pub fn pair_energy_reference<D: Real>(
                 let di = xa[i].clone() - xb[i].clone();
                 dist2 += di.clone() * di;
             }
-            let rho = dist2.sqrt() / (2.0 * radius);
+            let rho = dist2.sqrt() / (radius.clone() * 2.0);
             if rho.re() < 1.0 {
                 let rho2 = rho.clone() * rho;
                 let f = rho2.recip() + rho2 - 2.0;
