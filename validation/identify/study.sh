@@ -7,16 +7,7 @@
 #   validation/identify/study.sh [pattern …]
 set -uo pipefail
 cd "$(dirname "$0")/../.."
-HYLC=${HYLC:-target/release/hylc}
-D=${HYLC_SHARED:-../shared}/data/hylc2020
-OUT=validation/identify
-if [ ! -d "$D" ]; then
-  echo "skipped: $D not found (set HYLC_SHARED)"; exit 0
-fi
-declare -A MAT=([basket]=basket1 [satin]=satin1 [slip_stitch_honeycomb]=honey1 [stockinette]=stock1 [cartridge_belt_rib]=rib1)
-declare -A DISP=([basket]=basket [satin]=satin [slip_stitch_honeycomb]=honey [stockinette]=stock [cartridge_belt_rib]=rib)
-PATTERNS=("$@")
-[ ${#PATTERNS[@]} -eq 0 ] && PATTERNS=(basket satin slip_stitch_honeycomb stockinette cartridge_belt_rib)
+. validation/identify/common.sh
 for pat in "${PATTERNS[@]}"; do
   mat=${MAT[$pat]:?unknown pattern $pat}
   yarn="$OUT/$pat/identified.yarn.json"
