@@ -177,6 +177,24 @@ fn physical_parameters_out_of_range_are_errors_naming_the_field() {
             Box::new(|s| s.fabric_angle_deg = f64::NAN),
         ),
         (
+            "field `model.fold_barrier.angle`",
+            Box::new(|s| {
+                s.model.fold_barrier = Some(hylc::shell::fold::FoldBarrier {
+                    angle: 3.2,
+                    stiffness: 1.0,
+                })
+            }),
+        ),
+        (
+            "field `model.fold_barrier.stiffness`",
+            Box::new(|s| {
+                s.model.fold_barrier = Some(hylc::shell::fold::FoldBarrier {
+                    angle: 2.0,
+                    stiffness: -1.0,
+                })
+            }),
+        ),
+        (
             "field `obstacles[0]`",
             Box::new(|s| {
                 s.obstacles = vec![hylc::shell::scene::ObstacleSpec::Plane {
@@ -260,6 +278,7 @@ fn a_material_with_a_non_finite_energy_is_reported_as_such() {
         in_plane_only: false,
         stiffness: 1.0,
         bending_scale: 1.0,
+        fold: None,
     };
     let model = ElementModel::new(&material, &flags, Psd::Psi);
     let mesh = Mesh::rectangle(0.1, 0.1, 0.02, 0.0, 1).unwrap();

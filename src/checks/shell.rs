@@ -22,8 +22,11 @@ use crate::material::Material;
 use crate::real::Real;
 use crate::shell::assemble::{gather, Pattern};
 use crate::shell::element::{energy_reference, ElementModel, ModelFlags, Psd};
+use crate::shell::fold::FoldBarrier;
 use crate::shell::mesh::{Mesh, Stencil};
-use crate::shell::strain::{strain_reference, RestTriangle, StrainChain, NDOF};
+use crate::shell::strain::{
+    hinge_angles_reference, strain_reference, RestTriangle, StrainChain, NDOF,
+};
 use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -279,6 +282,20 @@ impl Differentiable for StrainCheck {
     }
 }
 
+/// |∂θ_k/∂x_i| of the three hinge angles at a sample, by central differences (a slope bound for the kink
+/// distance only).
+fn strain_angles_gradient(x: &[f64], i: usize) -> [f64; 3] {
+    let (_, flaps) = rest_of(x);
+    let h = 1e-7 * chain_magnitudes(x).2;
+    let at = |s: f64| {
+        let mut q = q_of(x);
+        q[i] += s;
+        hinge_angles_reference(&q, flaps).map(|t| t.unwrap_or(0.0))
+    };
+    let (p, m) = (at(h), at(-h));
+    std::array::from_fn(|k| ((p[k] - m[k]) / (2.0 * h)).abs())
+}
+
 /// Data magnitude V of a material and its smallest in-plane and bending strain scales.
 fn material_magnitudes(m: &Material) -> (f64, f64, f64) {
     let max_abs = |p: &[f64]| p.iter().fold(0.0f64, |a, x| a.max(x.abs()));
@@ -307,11 +324,35 @@ impl TriangleCheck {
         let c = rest.area * self.model.stiffness * v;
         let beta = self.model.bending_scale;
         let (gs, gb) = (s[1] / ss, beta * b[1] / sb);
+        let f = self.fold_scales(x);
         Scales {
-            value: c,
-            gradient: c * (gs + gb),
-            hessian: c * (gs * gs + gb * gb + s[2] / ss + beta * b[2] / sb),
+            value: c + f[0],
+            gradient: c * (gs + gb) + f[1],
+            hessian: c * (gs * gs + gb * gb + s[2] / ss + beta * b[2] / sb) + f[2],
         }
+    }
+
+    /// The fold barrier's magnitudes at a sample: k_f A/3 Σ_i (β, |β′| g_θ, β″ g_θ² + |β′| g_θ²) with g_θ =
+    /// 1/h_min the natural scale of ∇θ (∇²θ scales as g_θ²); zeros without a barrier.
+    fn fold_scales(&self, x: &[f64]) -> [f64; 3] {
+        let Some(fold) = &self.model.fold else {
+            return [0.0; 3];
+        };
+        let (rest, flaps) = rest_of(x);
+        let g = 1.0 / chain_magnitudes(x).2;
+        let c = fold.weight(rest.area);
+        let mut out = [0.0; 3];
+        let Some(ch) = StrainChain::new(&q_of(x), &rest, flaps) else {
+            return out;
+        };
+        for i in 0..3 {
+            if let Some([b, b1, b2]) = ch.hinge_angle(i).and_then(|t| fold.profile(t)) {
+                out[0] += c * b;
+                out[1] += c * b1.abs() * g;
+                out[2] += c * (b2 + b1.abs()) * g * g;
+            }
+        }
+        out
     }
 }
 
@@ -340,7 +381,18 @@ impl Differentiable for TriangleCheck {
         let s = [1.0, 1.0, 1.0, b, b, b];
         let zs: [f64; 6] = std::array::from_fn(|k| s[k] * ch.z[k]);
         let slope = (0..6).fold(0.0f64, |a, k| a.max((s[k] * ch.jac[k][i]).abs()));
-        0.5 * self.model.material.kink_distance(&zs) / slope.max(1e-300)
+        let mut d = 0.5 * self.model.material.kink_distance(&zs) / slope.max(1e-300);
+        // the fold barrier's threshold |θ| = θ_t (β is C² there; its third derivative jumps)
+        if let Some(fold) = &self.model.fold {
+            let theta = hinge_angles_reference(&q_of(x), flaps);
+            let probe = strain_angles_gradient(x, i);
+            for (k, t) in theta.iter().enumerate() {
+                if let Some(t) = t {
+                    d = d.min(0.5 * (t.abs() - fold.angle).abs() / probe[k].max(1e-300));
+                }
+            }
+        }
+        d
     }
     fn reference<D: Real>(&self, x: &[D]) -> D {
         let d: Vec<f64> = x[NDOF..].iter().map(|d| d.re()).collect();
@@ -538,6 +590,19 @@ pub fn diff_checks() -> Vec<Box<dyn Check>> {
     v.push(Box::new(TriangleCheck {
         name: "shell triangle energy[default]".into(),
         model: ElementModel::new(&m, &flags, Psd::None),
+    }));
+    // the fold barrier at a lower threshold than its default, so that a third of the sampled hinges (random
+    // folds in ±2.9 rad, every fourth stencil at ±170°) are beyond it
+    let folded = ModelFlags {
+        fold: Some(FoldBarrier {
+            angle: 2.0,
+            stiffness: 5.0,
+        }),
+        ..flags
+    };
+    v.push(Box::new(TriangleCheck {
+        name: "shell triangle energy with fold barrier[default]".into(),
+        model: ElementModel::new(&m, &folded, Psd::None),
     }));
     if let Some(dir) = crate::shared_dir() {
         if let Ok(mat) = Material::load(&dir.join("data/hylc2020/materials/basket1.json")) {

@@ -7,6 +7,9 @@
 //!   at all (II ≡ 0); with only 1D terms (the original's `only1D`) or in-plane terms only, the material is reduced
 //!   to those terms once, so ψ evaluates only them.
 //! - ∇E = A k Jᵀ S ∇ψ, ∇²E = A k (Jᵀ S ∇²ψ S J + Σ_k (S∇ψ)_k ∇²z_k).
+//! - With a fold barrier ([`FoldBarrier`], [`super::fold`]; only with bending) E_Δ also has Σ_i k_f (A/3) β(θ_i)
+//!   over its hinges, with ∇ = Σ c β′ ∇θ_i and ∇² = Σ c (β″ ∇θ_i ∇θ_iᵀ + β′ ∇²θ_i); option (b) keeps only the
+//!   PSD part c β″ ∇θ_i ∇θ_iᵀ (β″ ≥ 0), option (a) projects the sum.
 //!
 //! PSD options ([`Psd`]): (a) eigen-projection of the 18×18 local Hessian, eigenvalues clamped at 1e-8 like the
 //! original; (b) projection of the 6×6 ∇²ψ only, keeping of the Σ ∂ψ/∂z_k ∇²z_k term only the stretch parts whose
@@ -14,7 +17,10 @@
 //! for "only where it is PSD"); (c) the exact Hessian, the solver adding a global diagonal shift when the
 //! factorisation fails.
 
-use super::strain::{strain, RestTriangle, StrainChain, NDOF};
+use super::fold::FoldBarrier;
+use super::strain::{
+    hinge_angles_reference, strain, strain_angles, RestTriangle, StrainChain, NDOF,
+};
 use crate::material::Material;
 use nalgebra::{SMatrix, SymmetricEigen};
 
@@ -46,6 +52,8 @@ pub struct ModelFlags {
     pub stiffness: f64,
     /// bending scale β (multiplies II before ψ)
     pub bending_scale: f64,
+    /// the fold barrier (acts only with bending)
+    pub fold: Option<FoldBarrier>,
 }
 
 impl Default for ModelFlags {
@@ -56,6 +64,7 @@ impl Default for ModelFlags {
             in_plane_only: false,
             stiffness: 1.0,
             bending_scale: 1.0,
+            fold: None,
         }
     }
 }
@@ -68,6 +77,8 @@ pub struct ElementModel {
     pub stiffness: f64,
     pub bending_scale: f64,
     pub psd: Psd,
+    /// the fold barrier; `None` without bending
+    pub fold: Option<FoldBarrier>,
 }
 
 impl ElementModel {
@@ -88,6 +99,7 @@ impl ElementModel {
             stiffness: flags.stiffness,
             bending_scale: flags.bending_scale,
             psd,
+            fold: flags.fold.filter(|_| bending),
         }
     }
 
@@ -119,9 +131,52 @@ impl ElementModel {
 
     /// E_Δ only; `None` on a degenerate configuration.
     pub fn energy(&self, q: &[f64; NDOF], rest: &RestTriangle, flaps: [bool; 3]) -> Option<f64> {
-        let z = strain(q, rest, self.flaps(flaps))?;
-        let e = rest.area * self.stiffness * self.material.value(&self.scaled(&z));
+        let flaps = self.flaps(flaps);
+        let mut e;
+        if let Some(fold) = &self.fold {
+            let (z, angles) = strain_angles(q, rest, flaps)?;
+            e = rest.area * self.stiffness * self.material.value(&self.scaled(&z));
+            for i in (0..3).filter(|&i| flaps[i]) {
+                e += fold.weight(rest.area) * fold.profile(angles[i])?[0];
+            }
+        } else {
+            let z = strain(q, rest, flaps)?;
+            e = rest.area * self.stiffness * self.material.value(&self.scaled(&z));
+        }
         e.is_finite().then_some(e)
+    }
+
+    /// Add the fold barrier's energy, gradient and (with `hess`) Hessian, the curvature term β′ ∇²θ only when
+    /// `curvature`; `None` when a hinge is folded flat (infinite energy).
+    fn add_fold(
+        &self,
+        ch: &StrainChain,
+        area: f64,
+        grad: &mut [f64; NDOF],
+        hess: Option<(&mut [[f64; NDOF]; NDOF], bool)>,
+    ) -> Option<f64> {
+        let Some(fold) = &self.fold else {
+            return Some(0.0);
+        };
+        let c = fold.weight(area);
+        let mut e = 0.0;
+        let mut scratch = [[0.0; NDOF]; NDOF];
+        let (h, curvature) = match hess {
+            Some((h, curv)) => (h, curv),
+            None => (&mut scratch, false),
+        };
+        for i in 0..3 {
+            let Some(theta) = ch.hinge_angle(i) else {
+                continue;
+            };
+            let [b, b1, b2] = fold.profile(theta)?;
+            if b1 == 0.0 && b2 == 0.0 {
+                continue;
+            }
+            e += c * b;
+            ch.add_hinge_angle_terms(i, c * b1, c * b2, curvature, grad, h);
+        }
+        Some(e)
     }
 
     /// E_Δ and ∇E_Δ (written to `grad`).
@@ -138,7 +193,7 @@ impl ElementModel {
         for j in 0..NDOF {
             grad[j] = (0..6).map(|k| w[k] * ch.jac[k][j]).sum();
         }
-        let e = rest.area * self.stiffness * p.value;
+        let e = rest.area * self.stiffness * p.value + self.add_fold(&ch, rest.area, grad, None)?;
         e.is_finite().then_some((e, ch.z))
     }
 
@@ -176,8 +231,13 @@ impl ElementModel {
         for j in 0..NDOF {
             grad[j] = (0..6).map(|k| w[k] * jac[k][j]).sum();
         }
-        self.hessian_into(&ch, &p, c, &w, self.psd, hess);
-        let e = c * p.value;
+        // option (a) projects the sum of the material's and the barrier's Hessians
+        let base = match self.psd {
+            Psd::Full if self.fold_active(&ch) => Psd::None,
+            psd => psd,
+        };
+        self.hessian_into(&ch, &p, c, &w, base, hess);
+        let e = c * p.value + self.fold_into(&ch, rest.area, self.psd, grad, hess)?;
         e.is_finite().then_some((e, ch.z))
     }
 
@@ -199,16 +259,46 @@ impl ElementModel {
             grad[j] = (0..6).map(|k| w[k] * ch.jac[k][j]).sum();
         }
         self.hessian_into(&ch, &p, c, &w, Psd::None, exact);
+        let mut g2 = *grad;
+        let ef = self.fold_into(&ch, rest.area, Psd::None, grad, exact)?;
         match self.psd {
             Psd::None => *projected = *exact,
             Psd::Full => {
                 *projected = *exact;
                 project18(projected);
             }
-            Psd::Psi => self.hessian_into(&ch, &p, c, &w, Psd::Psi, projected),
+            Psd::Psi => {
+                self.hessian_into(&ch, &p, c, &w, Psd::Psi, projected);
+                self.fold_into(&ch, rest.area, Psd::Psi, &mut g2, projected)?;
+            }
         }
-        let e = c * p.value;
+        let e = c * p.value + ef;
         e.is_finite().then_some((e, ch.z))
+    }
+
+    /// Whether a hinge is folded beyond the barrier's threshold.
+    fn fold_active(&self, ch: &StrainChain) -> bool {
+        self.fold
+            .is_some_and(|f| (0..3).any(|i| ch.hinge_angle(i).is_some_and(|t| t.abs() > f.angle)))
+    }
+
+    /// The fold barrier's terms added to a gradient and a local Hessian: the exact terms for (c), the PSD part
+    /// for (b); for (a) the exact terms, then the projection of the sum (the caller passes the unprojected
+    /// material Hessian when a hinge is beyond the threshold). Returns the barrier's energy; `None` when a hinge
+    /// is folded flat.
+    fn fold_into(
+        &self,
+        ch: &StrainChain,
+        area: f64,
+        psd: Psd,
+        grad: &mut [f64; NDOF],
+        hess: &mut [[f64; NDOF]; NDOF],
+    ) -> Option<f64> {
+        let e = self.add_fold(ch, area, grad, Some((hess, psd != Psd::Psi)))?;
+        if psd == Psd::Full && e != 0.0 {
+            project18(hess);
+        }
+        Some(e)
     }
 
     /// The local Hessian for PSD option `psd` from the chain, ψ's derivatives, c = A k and the weights w.
@@ -368,5 +458,14 @@ pub fn energy_reference<D: crate::real::Real>(
         z[4].clone() * b,
         z[5].clone() * b,
     ];
-    model.material.reference(&zs) * (rest.area * model.stiffness)
+    let mut e = model.material.reference(&zs) * (rest.area * model.stiffness);
+    if let Some(fold) = &model.fold {
+        for theta in hinge_angles_reference(q, model.flaps(flaps))
+            .into_iter()
+            .flatten()
+        {
+            e += fold.reference(theta) * fold.weight(rest.area);
+        }
+    }
+    e
 }

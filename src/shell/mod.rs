@@ -16,6 +16,7 @@ pub mod arcsim;
 pub mod assemble;
 pub mod dissipation;
 pub mod element;
+pub mod fold;
 pub mod mesh;
 pub mod obstacle;
 pub mod render;

@@ -20,7 +20,7 @@
 //! these expressions (each wing depends on (e, w) only), and κ_i = θ_i h_i by the product rule.
 //! Only the contraction Σ_k w_k ∇²z_k is formed; the full 6×18×18 tensor is the contraction with unit vectors.
 
-use crate::real::Real;
+use crate::real::{self, Real, V3 as V3r};
 use nalgebra::{Matrix3, Vector3};
 
 type V3 = Vector3<f64>;
@@ -172,6 +172,15 @@ fn in_plane(q: &[f64; NDOF], rest: &RestTriangle) -> Option<([V3; 2], [f64; 2])>
 /// z(q) only (the fast value path). `None` when the deformed triangle or a hinge is degenerate (zero-length
 /// edge, zero area, non-finite input).
 pub fn strain(q: &[f64; NDOF], rest: &RestTriangle, flaps: [bool; 3]) -> Option<[f64; 6]> {
+    strain_angles(q, rest, flaps).map(|(z, _)| z)
+}
+
+/// z(q) and the hinge angles θ_i (0 for a missing flap), as [`strain`].
+pub fn strain_angles(
+    q: &[f64; NDOF],
+    rest: &RestTriangle,
+    flaps: [bool; 3],
+) -> Option<([f64; 6], [f64; 3])> {
     if !admissible_positions(q) {
         return None;
     }
@@ -187,6 +196,7 @@ pub fn strain(q: &[f64; NDOF], rest: &RestTriangle, flaps: [bool; 3]) -> Option<
     let coef = rest.bend_coeffs();
     let n0 = (vtx(q, 1) - vtx(q, 0)).cross(&(vtx(q, 2) - vtx(q, 0)));
     let na = n0.norm();
+    let mut angles = [0.0; 3];
     for i in 0..3 {
         if !flaps[i] {
             continue;
@@ -198,7 +208,8 @@ pub fn strain(q: &[f64; NDOF], rest: &RestTriangle, flaps: [bool; 3]) -> Option<
         if !(le > 0.0 && na > 0.0) {
             return None;
         }
-        let kappa = hinge_angle(&e, &n0, &b) * na / le;
+        angles[i] = hinge_angle(&e, &n0, &b);
+        let kappa = angles[i] * na / le;
         if !kappa.is_finite() {
             return None;
         }
@@ -206,7 +217,7 @@ pub fn strain(q: &[f64; NDOF], rest: &RestTriangle, flaps: [bool; 3]) -> Option<
             z[3 + c] += kappa * coef[i][c];
         }
     }
-    Some(z)
+    Some((z, angles))
 }
 
 impl StrainChain {
@@ -320,6 +331,41 @@ impl StrainChain {
         }
     }
 
+    /// The angle θ_i of hinge i (`None` without its flap).
+    pub fn hinge_angle(&self, i: usize) -> Option<f64> {
+        self.hinges[i].as_ref().map(|hg| hg.theta)
+    }
+
+    /// For a function φ(θ_i) of hinge i's angle with derivatives φ′ = `d1`, φ″ = `d2`: add φ′ ∇θ_i to `grad` and
+    /// φ″ ∇θ_i ∇θ_iᵀ (+ φ′ ∇²θ_i when `curvature`) to `hess`. Nothing without the flap.
+    pub fn add_hinge_angle_terms(
+        &self,
+        i: usize,
+        d1: f64,
+        d2: f64,
+        curvature: bool,
+        grad: &mut [f64; NDOF],
+        hess: &mut [[f64; NDOF]; NDOF],
+    ) {
+        let Some(hg) = &self.hinges[i] else {
+            return;
+        };
+        let idx = hinge(i);
+        let mut hb = [[M3::zeros(); 4]; 4];
+        if curvature {
+            add_theta_hessian(hg, d1, &mut hb);
+        }
+        for j in 0..4 {
+            for l in 0..4 {
+                hb[j][l] += hg.dtheta[j] * hg.dtheta[l].transpose() * d2;
+            }
+            for k in 0..3 {
+                grad[3 * idx[j] + k] += d1 * hg.dtheta[j][k];
+            }
+        }
+        scatter(&hb, idx, hess);
+    }
+
     /// Σ_k w_k ∇²z_k as a fresh matrix.
     pub fn weighted_hessian(&self, w: &[f64; 6]) -> [[f64; NDOF]; NDOF] {
         let mut out = [[0.0; NDOF]; NDOF];
@@ -378,10 +424,9 @@ fn wing(e: &V3, w: &V3) -> (V3, M3, M3, f64, V3, V3) {
     (g, dge, dgw, t, te, tw)
 }
 
-/// Add ω ∇²κ of one hinge (κ = θ h) to the stencil Hessian.
-fn add_hinge_hessian(hg: &Hinge, omega: f64, idx: [usize; 4], out: &mut [[f64; NDOF]; NDOF]) {
-    let mut hb = [[M3::zeros(); 4]; 4];
-    // ∇²θ, wing by wing: the wing's gradient rows (p₀, p₁, p_w) = ±((1−t)G, tG, −G) differentiated in (e, w).
+/// Add c ∇²θ of one hinge to its 4×4 blocks (p₀, p₁, p₂, p₃), wing by wing: the wing's gradient rows
+/// (p₀, p₁, p_w) = ±((1−t)G, tG, −G) differentiated in (e, w).
+fn add_theta_hessian(hg: &Hinge, c: f64, hb: &mut [[M3; 4]; 4]) {
     for (w, pw, sign) in [(&hg.a, 2usize, -1.0), (&hg.b, 3usize, 1.0)] {
         let (g, dge, dgw, t, te, tw) = wing(&hg.e, w);
         let k1e = g * te.transpose() + dge * t;
@@ -393,13 +438,33 @@ fn add_hinge_hessian(hg: &Hinge, omega: f64, idx: [usize; 4], out: &mut [[f64; N
         ];
         for (r, ke, kw) in rows {
             // columns: ∂/∂p₁ = ∂/∂e, ∂/∂p_w = ∂/∂w, ∂/∂p₀ = −∂/∂e − ∂/∂w
-            let ke = ke * (sign * hg.h * omega);
-            let kw = kw * (sign * hg.h * omega);
+            let ke = ke * (sign * c);
+            let kw = kw * (sign * c);
             hb[r][1] += ke;
             hb[r][pw] += kw;
             hb[r][0] -= ke + kw;
         }
     }
+}
+
+/// Add the 4×4 blocks of a hinge (vertices `idx` of the stencil) to the stencil Hessian.
+fn scatter(hb: &[[M3; 4]; 4], idx: [usize; 4], out: &mut [[f64; NDOF]; NDOF]) {
+    for (j, &pj) in idx.iter().enumerate() {
+        for (l, &pl) in idx.iter().enumerate() {
+            let blk = &hb[j][l];
+            for r in 0..3 {
+                for s in 0..3 {
+                    out[3 * pj + r][3 * pl + s] += blk[(r, s)];
+                }
+            }
+        }
+    }
+}
+
+/// Add ω ∇²κ of one hinge (κ = θ h) to the stencil Hessian.
+fn add_hinge_hessian(hg: &Hinge, omega: f64, idx: [usize; 4], out: &mut [[f64; NDOF]; NDOF]) {
+    let mut hb = [[M3::zeros(); 4]; 4];
+    add_theta_hessian(hg, hg.h * omega, &mut hb);
     // θ ∇²h in (e, a), mapped to (p₀, p₁, p₂)
     {
         let (e, a) = (&hg.e, &hg.a);
@@ -447,58 +512,46 @@ fn add_hinge_hessian(hg: &Hinge, omega: f64, idx: [usize; 4], out: &mut [[f64; N
             hb[l][j] += m.transpose();
         }
     }
-    for (j, &pj) in idx.iter().enumerate() {
-        for (l, &pl) in idx.iter().enumerate() {
-            let blk = &hb[j][l];
-            for r in 0..3 {
-                for s in 0..3 {
-                    out[3 * pj + r][3 * pl + s] += blk[(r, s)];
-                }
-            }
-        }
-    }
+    scatter(&hb, idx, out);
 }
 
 /// Generic reference twin of z(q), written from the definitions of `05-macro.md` (absolute difference vectors,
 /// atan2 for the angles).
 pub fn strain_reference<D: Real>(q: &[D], rest: &RestTriangle, flaps: [bool; 3]) -> [D; 6] {
-    let p = |v: usize| [q[3 * v].clone(), q[3 * v + 1].clone(), q[3 * v + 2].clone()];
-    let sub = |a: &[D; 3], b: &[D; 3]| [0, 1, 2].map(|k| a[k].clone() - b[k].clone());
-    let dot = |a: &[D; 3], b: &[D; 3]| {
-        a[0].clone() * b[0].clone() + a[1].clone() * b[1].clone() + a[2].clone() * b[2].clone()
-    };
-    let cross = |a: &[D; 3], b: &[D; 3]| {
-        [
-            a[1].clone() * b[2].clone() - a[2].clone() * b[1].clone(),
-            a[2].clone() * b[0].clone() - a[0].clone() * b[2].clone(),
-            a[0].clone() * b[1].clone() - a[1].clone() * b[0].clone(),
-        ]
-    };
-    let x = [p(0), p(1), p(2), p(3), p(4), p(5)];
-    let (d1, d2) = (sub(&x[1], &x[0]), sub(&x[2], &x[0]));
+    let x: [V3r<D>; 6] = std::array::from_fn(|v| real::v3(&q[3 * v..]));
+    let (d1, d2) = (real::sub(&x[1], &x[0]), real::sub(&x[2], &x[0]));
     let d = &rest.inv_dm;
     let col = |c: usize| [0, 1, 2].map(|k| d1[k].clone() * d[0][c] + d2[k].clone() * d[1][c]);
     let (f0, f1) = (col(0), col(1));
-    let (l0, l1) = (dot(&f0, &f0).sqrt(), dot(&f1, &f1).sqrt());
-    let sa = dot(&f0, &f1) / (l0.clone() * l1.clone());
-    let n0 = cross(&d1, &d2);
-    let n0_len = dot(&n0, &n0).sqrt();
+    let (l0, l1) = (real::norm(&f0), real::norm(&f1));
+    let sa = real::dot(&f0, &f1) / (l0.clone() * l1.clone());
+    let n0_len = real::norm(&real::cross(&d1, &d2));
     let r = rest.r();
     let mut ii = [D::from(0.0), D::from(0.0), D::from(0.0)];
-    for i in 0..3 {
-        if !flaps[i] {
+    for (i, angle) in hinge_angles_reference(q, flaps).into_iter().enumerate() {
+        let Some(theta) = angle else {
             continue;
-        }
-        let e = sub(&x[(i + 1) % 3], &x[i]);
-        let le = dot(&e, &e).sqrt();
-        let ni = cross(&sub(&x[3 + i], &x[i]), &e);
-        let y = dot(&e, &cross(&n0, &ni)) / le.clone();
-        let theta = -y.atan2(dot(&n0, &ni));
-        let kappa = theta * n0_len.clone() / le;
+        };
+        let kappa = theta * n0_len.clone() / real::norm(&real::sub(&x[(i + 1) % 3], &x[i]));
         ii[0] += kappa.clone() * (r[i][0] * r[i][0]);
         ii[1] += kappa.clone() * (r[i][0] * r[i][1]);
         ii[2] += kappa * (r[i][1] * r[i][1]);
     }
     let [i00, i01, i11] = ii;
     [l0 - 1.0, sa, l1 - 1.0, i00, i01, i11]
+}
+
+/// Generic reference twin of the hinge angles θ_i = −atan2(ê_i·(n₀×n_i), n₀·n_i) of a stencil (`None` without
+/// the flap).
+pub fn hinge_angles_reference<D: Real>(q: &[D], flaps: [bool; 3]) -> [Option<D>; 3] {
+    let x: [V3r<D>; 6] = std::array::from_fn(|v| real::v3(&q[3 * v..]));
+    let n0 = real::cross(&real::sub(&x[1], &x[0]), &real::sub(&x[2], &x[0]));
+    std::array::from_fn(|i| {
+        flaps[i].then(|| {
+            let e = real::sub(&x[(i + 1) % 3], &x[i]);
+            let ni = real::cross(&real::sub(&x[3 + i], &x[i]), &e);
+            let y = real::dot(&e, &real::cross(&n0, &ni)) / real::norm(&e);
+            -y.atan2(real::dot(&n0, &ni))
+        })
+    })
 }

@@ -54,6 +54,7 @@ impl Scene {
             in_plane_only: self.model.in_plane_only,
             stiffness: self.model.stiffness,
             bending_scale: self.model.bending_scale,
+            fold: self.model.fold_barrier,
         };
         let model = ElementModel::new(&material, &flags, self.psd);
         let mut pins = Vec::new();

@@ -16,7 +16,8 @@
 //!   "handle_stiffness": null,                    // null: pins and handles are hard constraints; a number k
 //!                                                // (N/m): each held vertex is a spring ½ k |x − target|²
 //!   "model": {"bending": true, "only_1d": false, "in_plane_only": false,
-//!             "stiffness": 1.0, "bending_scale": 1.0, "mass": 1.0},
+//!             "stiffness": 1.0, "bending_scale": 1.0, "mass": 1.0,
+//!             "fold_barrier": {"angle": 2.5, "stiffness": 1.0}},   // null: none (`super::fold`)
 //!   "psd": "full",                               // "full" (18×18), "psi" (6×6), "none" (diagonal shift)
 //!   "solver": {"force_tol": 1e-6, "max_newton": 50, "exact_first": true, "max_halvings": 6},
 //!   "pins": [{"near": {"point": [0, 0], "radius": 0.01}}],
@@ -36,6 +37,7 @@
 
 pub use super::dissipation::Wind;
 use super::element::{ElementModel, ModelFlags, Psd};
+pub use super::fold::FoldBarrier;
 use super::mesh::{load_obj_surface, write_obj, Mesh};
 use super::obstacle::{MeshObstacle, Obstacle};
 use super::solver::{Boundary, Handle, Settings, Simulation, StepReport};
@@ -232,6 +234,13 @@ pub struct ModelSpec {
     pub bending_scale: f64,
     #[serde(default = "one")]
     pub mass: f64,
+    /// the fold barrier ([`FoldBarrier`]); on by default, `null` turns it off
+    #[serde(default = "default_fold")]
+    pub fold_barrier: Option<FoldBarrier>,
+}
+
+fn default_fold() -> Option<FoldBarrier> {
+    Some(FoldBarrier::default())
 }
 
 impl Default for ModelSpec {
@@ -243,6 +252,7 @@ impl Default for ModelSpec {
             stiffness: 1.0,
             bending_scale: 1.0,
             mass: 1.0,
+            fold_barrier: default_fold(),
         }
     }
 }

@@ -93,6 +93,9 @@ impl Scene {
                 format!("must be a non-negative number, got {}", m.bending_scale),
             );
         }
+        if let Some(Err((key, msg))) = m.fold_barrier.map(|f| f.check()) {
+            return bad(&format!("model.fold_barrier.{key}"), msg);
+        }
         if self.solver.force_tol.is_nan() || self.solver.force_tol <= 0.0 {
             return bad(
                 "solver.force_tol",
