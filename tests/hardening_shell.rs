@@ -186,6 +186,15 @@ fn physical_parameters_out_of_range_are_errors_naming_the_field() {
             }),
         ),
         (
+            "field `model.collapse_barrier.area`",
+            Box::new(|s| {
+                s.model.collapse_barrier = Some(hylc::shell::fold::CollapseBarrier {
+                    area: 1.0,
+                    stiffness: 1.0,
+                })
+            }),
+        ),
+        (
             "field `model.fold_barrier.stiffness`",
             Box::new(|s| {
                 s.model.fold_barrier = Some(hylc::shell::fold::FoldBarrier {
@@ -279,6 +288,7 @@ fn a_material_with_a_non_finite_energy_is_reported_as_such() {
         stiffness: 1.0,
         bending_scale: 1.0,
         fold: None,
+        collapse: None,
     };
     let model = ElementModel::new(&material, &flags, Psd::Psi);
     let mesh = Mesh::rectangle(0.1, 0.1, 0.02, 0.0, 1).unwrap();

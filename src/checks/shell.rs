@@ -22,7 +22,7 @@ use crate::material::Material;
 use crate::real::Real;
 use crate::shell::assemble::{gather, Pattern};
 use crate::shell::element::{energy_reference, ElementModel, ModelFlags, Psd};
-use crate::shell::fold::FoldBarrier;
+use crate::shell::fold::{CollapseBarrier, FoldBarrier};
 use crate::shell::mesh::{Mesh, Stencil};
 use crate::shell::strain::{
     hinge_angles_reference, strain_reference, RestTriangle, StrainChain, NDOF,
@@ -325,11 +325,37 @@ impl TriangleCheck {
         let beta = self.model.bending_scale;
         let (gs, gb) = (s[1] / ss, beta * b[1] / sb);
         let f = self.fold_scales(x);
+        let k = self.collapse_scales(x);
         Scales {
-            value: c + f[0],
-            gradient: c * (gs + gb) + f[1],
-            hessian: c * (gs * gs + gb * gb + s[2] / ss + beta * b[2] / sb) + f[2],
+            value: c + f[0] + k[0],
+            gradient: c * (gs + gb) + f[1] + k[1],
+            hessian: c * (gs * gs + gb * gb + s[2] / ss + beta * b[2] / sb) + f[2] + k[2],
         }
+    }
+
+    /// The collapse barrier's magnitudes at a sample: A k (|φ|, ‖∇_z φ‖₁ g_s, ‖∇²_z φ‖ g_s² + ‖∇_z φ‖₁ h_s) for its
+    /// density φ, with (g_s, h_s) the in-plane chain's gradient and Hessian scales; zeros without a barrier.
+    fn collapse_scales(&self, x: &[f64]) -> [f64; 3] {
+        let Some(cb) = &self.model.collapse else {
+            return [0.0; 3];
+        };
+        let (rest, flaps) = rest_of(x);
+        let (s, _, _) = chain_magnitudes(x);
+        let Some(z) = crate::shell::strain::strain(&q_of(x), &rest, flaps) else {
+            return [0.0; 3];
+        };
+        let (mut v, mut g, mut h) = (0.0, [0.0; 6], [[0.0; 6]; 6]);
+        if cb.add_to(&z, &mut v, &mut g, &mut h).is_none() {
+            return [0.0; 3];
+        }
+        let c = rest.area * self.model.stiffness;
+        let g1: f64 = g.iter().map(|a| a.abs()).sum();
+        let hn = h.iter().flatten().map(|a| a * a).sum::<f64>().sqrt();
+        [
+            c * v.abs(),
+            c * g1 * s[1],
+            c * (hn * s[1] * s[1] + g1 * s[2]),
+        ]
     }
 
     /// The fold barrier's magnitudes at a sample: k_f A/3 Σ_i (β, |β′| g_θ, β″ g_θ² + |β′| g_θ²) with g_θ =
@@ -382,6 +408,15 @@ impl Differentiable for TriangleCheck {
         let zs: [f64; 6] = std::array::from_fn(|k| s[k] * ch.z[k]);
         let slope = (0..6).fold(0.0f64, |a, k| a.max((s[k] * ch.jac[k][i]).abs()));
         let mut d = 0.5 * self.model.material.kink_distance(&zs) / slope.max(1e-300);
+        // the collapse barrier's threshold J = J_t (C² there)
+        if let Some(cb) = &self.model.collapse {
+            let z = &ch.z;
+            let c = (1.0 - z[1] * z[1]).max(0.0).sqrt();
+            let (a, bb) = (1.0 + z[0], 1.0 + z[2]);
+            let gj = [bb * c, -a * bb * z[1] / c.max(1e-300), a * c];
+            let dj = (0..3).map(|k| gj[k] * ch.jac[k][i]).sum::<f64>().abs();
+            d = d.min(0.5 * (a * bb * c - cb.area).abs() / dj.max(1e-300));
+        }
         // the fold barrier's threshold |θ| = θ_t (β is C² there; its third derivative jumps)
         if let Some(fold) = &self.model.fold {
             let theta = hinge_angles_reference(&q_of(x), flaps);
@@ -603,6 +638,19 @@ pub fn diff_checks() -> Vec<Box<dyn Check>> {
     v.push(Box::new(TriangleCheck {
         name: "shell triangle energy with fold barrier[default]".into(),
         model: ElementModel::new(&m, &folded, Psd::None),
+    }));
+    // the collapse barrier at J_t = 0.6, beyond which a fifth of the sampled triangles lie (principal stretches
+    // in [0.1, 3])
+    let collapsing = ModelFlags {
+        collapse: Some(CollapseBarrier {
+            area: 0.6,
+            stiffness: 5.0,
+        }),
+        ..flags
+    };
+    v.push(Box::new(TriangleCheck {
+        name: "shell triangle energy with collapse barrier[default]".into(),
+        model: ElementModel::new(&m, &collapsing, Psd::None),
     }));
     if let Some(dir) = crate::shared_dir() {
         if let Ok(mat) = Material::load(&dir.join("data/hylc2020/materials/basket1.json")) {

@@ -10,6 +10,8 @@
 //! - With a fold barrier ([`FoldBarrier`], [`super::fold`]; only with bending) E_Δ also has Σ_i k_f (A/3) β(θ_i)
 //!   over its hinges, with ∇ = Σ c β′ ∇θ_i and ∇² = Σ c (β″ ∇θ_i ∇θ_iᵀ + β′ ∇²θ_i); option (b) keeps only the
 //!   PSD part c β″ ∇θ_i ∇θ_iᵀ (β″ ≥ 0), option (a) projects the sum.
+//! - With a collapse barrier ([`CollapseBarrier`]) its density k_c β_J(J(z)) is added to ψ before the chain rule,
+//!   so it takes every path ψ takes (projection of the 6×6 block for (b)).
 //!
 //! PSD options ([`Psd`]): (a) eigen-projection of the 18×18 local Hessian, eigenvalues clamped at 1e-8 like the
 //! original; (b) projection of the 6×6 ∇²ψ only, keeping of the Σ ∂ψ/∂z_k ∇²z_k term only the stretch parts whose
@@ -17,7 +19,7 @@
 //! for "only where it is PSD"); (c) the exact Hessian, the solver adding a global diagonal shift when the
 //! factorisation fails.
 
-use super::fold::FoldBarrier;
+use super::fold::{CollapseBarrier, FoldBarrier};
 use super::strain::{
     hinge_angles_reference, strain, strain_angles, RestTriangle, StrainChain, NDOF,
 };
@@ -54,6 +56,8 @@ pub struct ModelFlags {
     pub bending_scale: f64,
     /// the fold barrier (acts only with bending)
     pub fold: Option<FoldBarrier>,
+    /// the collapse barrier
+    pub collapse: Option<CollapseBarrier>,
 }
 
 impl Default for ModelFlags {
@@ -65,6 +69,7 @@ impl Default for ModelFlags {
             stiffness: 1.0,
             bending_scale: 1.0,
             fold: None,
+            collapse: None,
         }
     }
 }
@@ -79,6 +84,8 @@ pub struct ElementModel {
     pub psd: Psd,
     /// the fold barrier; `None` without bending
     pub fold: Option<FoldBarrier>,
+    /// the collapse barrier
+    pub collapse: Option<CollapseBarrier>,
 }
 
 impl ElementModel {
@@ -100,6 +107,7 @@ impl ElementModel {
             bending_scale: flags.bending_scale,
             psd,
             fold: flags.fold.filter(|_| bending),
+            collapse: flags.collapse,
         }
     }
 
@@ -119,6 +127,27 @@ impl ElementModel {
         [z[0], z[1], z[2], b * z[3], b * z[4], b * z[5]]
     }
 
+    /// ψ(S z) and its derivatives in z-space before the chain rule (S applied by [`Self::weights`]), plus the
+    /// collapse barrier's density; `None` when a triangle has collapsed (J ≤ 0).
+    #[inline]
+    fn psi(&self, z: &[f64; 6]) -> Option<crate::material::PsiVgh> {
+        let mut p = self.material.eval(&self.scaled(z));
+        if let Some(c) = &self.collapse {
+            c.add_to(z, &mut p.value, &mut p.grad, &mut p.hess)?;
+        }
+        Some(p)
+    }
+
+    /// ψ(S z) plus the collapse barrier's density; `None` when a triangle has collapsed.
+    #[inline]
+    fn psi_value(&self, z: &[f64; 6]) -> Option<f64> {
+        let v = self.material.value(&self.scaled(z));
+        match &self.collapse {
+            Some(c) => Some(v + c.value(z)?),
+            None => Some(v),
+        }
+    }
+
     /// The strain z the model uses (bending zero when off), `None` on a degenerate configuration.
     pub fn strain(
         &self,
@@ -135,13 +164,13 @@ impl ElementModel {
         let mut e;
         if let Some(fold) = &self.fold {
             let (z, angles) = strain_angles(q, rest, flaps)?;
-            e = rest.area * self.stiffness * self.material.value(&self.scaled(&z));
+            e = rest.area * self.stiffness * self.psi_value(&z)?;
             for i in (0..3).filter(|&i| flaps[i]) {
                 e += fold.weight(rest.area) * fold.profile(angles[i])?[0];
             }
         } else {
             let z = strain(q, rest, flaps)?;
-            e = rest.area * self.stiffness * self.material.value(&self.scaled(&z));
+            e = rest.area * self.stiffness * self.psi_value(&z)?;
         }
         e.is_finite().then_some(e)
     }
@@ -188,7 +217,7 @@ impl ElementModel {
         grad: &mut [f64; NDOF],
     ) -> Option<(f64, [f64; 6])> {
         let ch = StrainChain::new(q, rest, self.flaps(flaps))?;
-        let p = self.material.eval(&self.scaled(&ch.z));
+        let p = self.psi(&ch.z)?;
         let (_, w) = self.weights(rest, &p.grad);
         for j in 0..NDOF {
             grad[j] = (0..6).map(|k| w[k] * ch.jac[k][j]).sum();
@@ -225,7 +254,7 @@ impl ElementModel {
         hess: &mut [[f64; NDOF]; NDOF],
     ) -> Option<(f64, [f64; 6])> {
         let ch = StrainChain::new(q, rest, self.flaps(flaps))?;
-        let p = self.material.eval(&self.scaled(&ch.z));
+        let p = self.psi(&ch.z)?;
         let (c, w) = self.weights(rest, &p.grad);
         let jac = &ch.jac;
         for j in 0..NDOF {
@@ -253,7 +282,7 @@ impl ElementModel {
         projected: &mut [[f64; NDOF]; NDOF],
     ) -> Option<(f64, [f64; 6])> {
         let ch = StrainChain::new(q, rest, self.flaps(flaps))?;
-        let p = self.material.eval(&self.scaled(&ch.z));
+        let p = self.psi(&ch.z)?;
         let (c, w) = self.weights(rest, &p.grad);
         for j in 0..NDOF {
             grad[j] = (0..6).map(|k| w[k] * ch.jac[k][j]).sum();
@@ -458,7 +487,11 @@ pub fn energy_reference<D: crate::real::Real>(
         z[4].clone() * b,
         z[5].clone() * b,
     ];
-    let mut e = model.material.reference(&zs) * (rest.area * model.stiffness);
+    let mut psi = model.material.reference(&zs);
+    if let Some(c) = &model.collapse {
+        psi += c.reference(&z);
+    }
+    let mut e = psi * (rest.area * model.stiffness);
     if let Some(fold) = &model.fold {
         for theta in hinge_angles_reference(q, model.flaps(flaps))
             .into_iter()

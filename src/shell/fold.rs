@@ -20,6 +20,15 @@
 //! and dβ/dθ = sgn(θ) β′(x), d²β/dθ² = β″(x). In physical terms the barrier stands in for the self-contact of
 //! the two wings of a sharp fold; below θ_t (default 2.5 rad, 143°; on a 6 mm mesh a curvature of about
 //! 400 m⁻¹) it does nothing, so scenes whose folds stay below it give the same results with or without it.
+//!
+//! **The collapse barrier** does the same for a triangle's area: with the area ratio
+//! J = (1 + s_x)(1 + s_y)√(1 − s_a²) (deformed over rest area, from the in-plane strains), a triangle whose J
+//! falls below J_t gets the energy density k_c β_J(J), β_J(J) = −(J − J_t)² ln(J / J_t), added to ψ (so the model's
+//! stiffness multiplier scales it too), infinite at J = 0. The fitted materials continue linearly beyond their
+//! sampled range, so a shear s_a → ±1 or a compression s → −1 (both J → 0: the yarns would have jammed long
+//! before) costs finite energy and a triangle can collapse: the original rib's soft shear lets a triangle at a
+//! drape's corner pin do that. Both barriers are the clamped log barrier b(d; d̂) = −(d − d̂)² ln(d/d̂) of a
+//! distance d below d̂ ([`log_barrier`]), with d = π − |θ| and d = J.
 
 use crate::real::Real;
 use serde::{Deserialize, Serialize};
@@ -65,37 +74,145 @@ impl FoldBarrier {
     /// (β, dβ/dθ, d²β/dθ²) at the hinge angle θ; `None` when |θ| ≥ π (folded flat: infinite energy).
     #[inline]
     pub fn profile(&self, theta: f64) -> Option<[f64; 3]> {
-        let x = theta.abs();
-        if x <= self.angle {
-            return Some([0.0; 3]);
-        }
-        let d = PI - x;
-        if d <= 0.0 || d.is_nan() {
-            return None;
-        }
-        let u = x - self.angle;
-        let l = (d / (PI - self.angle)).ln();
-        let b = -u * u * l;
-        let b1 = -2.0 * u * l + u * u / d;
-        let b2 = -2.0 * l + 4.0 * u / d + u * u / (d * d);
-        Some([b, theta.signum() * b1, b2])
+        let [b, b1, b2] = log_barrier(PI - theta.abs(), PI - self.angle)?;
+        Some([b, -theta.signum() * b1, b2])
     }
 
-    /// The generic reference twin of β(θ) (the same formula, for the derivative harness).
+    /// The generic reference twin of β(θ) (for the derivative harness).
     pub fn reference<D: Real>(&self, theta: D) -> D {
         let x = if theta.re() < 0.0 { -theta } else { theta };
-        if x.re() <= self.angle {
-            return D::from(0.0);
-        }
-        let u = x.clone() - self.angle;
-        let d = -x + PI;
-        -(u.clone() * u) * (d / (PI - self.angle)).ln()
+        log_barrier_reference(-x + PI, PI - self.angle)
     }
 
     /// The weight k_f A/3 of each hinge of a triangle of rest area A.
     #[inline]
     pub fn weight(&self, area: f64) -> f64 {
         self.stiffness * area / 3.0
+    }
+}
+
+/// The clamped log barrier b(d; d̂) = −(d − d̂)² ln(d/d̂) for 0 < d < d̂, 0 for d ≥ d̂, and its first two
+/// derivatives in d: b′ = −2(d − d̂) ln(d/d̂) − (d − d̂)²/d, b″ = −2 ln(d/d̂) − 4(d − d̂)/d + (d − d̂)²/d²
+/// (b = b′ = b″ = 0 at d̂; b′ < 0 and b″ > 0 below it). `None` for d ≤ 0 (infinite).
+#[inline]
+pub fn log_barrier(d: f64, dhat: f64) -> Option<[f64; 3]> {
+    if d >= dhat {
+        return Some([0.0; 3]);
+    }
+    if d.is_nan() || d <= 0.0 {
+        return None;
+    }
+    let u = d - dhat;
+    let l = (d / dhat).ln();
+    Some([
+        -u * u * l,
+        -2.0 * u * l - u * u / d,
+        -2.0 * l - 4.0 * u / d + u * u / (d * d),
+    ])
+}
+
+/// The generic reference twin of [`log_barrier`]'s value.
+pub fn log_barrier_reference<D: Real>(d: D, dhat: f64) -> D {
+    if d.re() >= dhat {
+        return D::from(0.0);
+    }
+    let u = d.clone() - dhat;
+    -(u.clone() * u) * (d / dhat).ln()
+}
+
+/// The collapse barrier's parameters (scene key `model.collapse_barrier`; module documentation).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CollapseBarrier {
+    /// J_t: the barrier acts on triangles whose area ratio falls below it, 0 < J_t < 1
+    pub area: f64,
+    /// k_c (J/m²): energy density scale
+    pub stiffness: f64,
+}
+
+impl Default for CollapseBarrier {
+    fn default() -> Self {
+        CollapseBarrier {
+            area: 0.2,
+            stiffness: 1.0,
+        }
+    }
+}
+
+impl CollapseBarrier {
+    /// A description of the first parameter out of range: (key, problem).
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        if !(self.area > 0.0 && self.area < 1.0) {
+            return Err((
+                "area",
+                format!("must lie strictly between 0 and 1, got {}", self.area),
+            ));
+        }
+        if !(self.stiffness > 0.0 && self.stiffness.is_finite()) {
+            return Err((
+                "stiffness",
+                format!("must be a positive number (J/m²), got {}", self.stiffness),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The energy density k_c β_J(J(z)) and its gradient and Hessian in z (only the in-plane block is non-zero)
+    /// added to `value`, `grad`, `hess`; `None` when J ≤ 0.
+    #[inline]
+    pub fn add_to(
+        &self,
+        z: &[f64; 6],
+        value: &mut f64,
+        grad: &mut [f64; 6],
+        hess: &mut [[f64; 6]; 6],
+    ) -> Option<()> {
+        let (a, b) = (1.0 + z[0], 1.0 + z[2]);
+        let c2 = 1.0 - z[1] * z[1];
+        if c2.is_nan() || c2 <= 0.0 {
+            return None;
+        }
+        let c = c2.sqrt();
+        let j = a * b * c;
+        let [v, d1, d2] = log_barrier(j, self.area)?;
+        if d1 == 0.0 && d2 == 0.0 {
+            return Some(());
+        }
+        let k = self.stiffness;
+        // ∇J and ∇²J in (s_x, s_a, s_y) = (z₀, z₁, z₂): c′ = −s_a/c, c″ = −1/c³
+        let (cp, cpp) = (-z[1] / c, -1.0 / (c2 * c));
+        let gj = [b * c, a * b * cp, a * c];
+        let hj = [
+            [0.0, b * cp, c],
+            [b * cp, a * b * cpp, a * cp],
+            [c, a * cp, 0.0],
+        ];
+        *value += k * v;
+        for p in 0..3 {
+            grad[p] += k * d1 * gj[p];
+            for q in 0..3 {
+                hess[p][q] += k * (d2 * gj[p] * gj[q] + d1 * hj[p][q]);
+            }
+        }
+        Some(())
+    }
+
+    /// The energy density alone; `None` when J ≤ 0.
+    #[inline]
+    pub fn value(&self, z: &[f64; 6]) -> Option<f64> {
+        let c2 = 1.0 - z[1] * z[1];
+        if c2.is_nan() || c2 <= 0.0 {
+            return None;
+        }
+        let j = (1.0 + z[0]) * (1.0 + z[2]) * c2.sqrt();
+        Some(self.stiffness * log_barrier(j, self.area)?[0])
+    }
+
+    /// The generic reference twin of the energy density at the in-plane strains of z.
+    pub fn reference<D: Real>(&self, z: &[D; 6]) -> D {
+        let c2 = -(z[1].clone() * z[1].clone()) + 1.0;
+        let j = (z[0].clone() + 1.0) * (z[2].clone() + 1.0) * c2.sqrt();
+        log_barrier_reference(j, self.area) * self.stiffness
     }
 }
 

@@ -55,6 +55,7 @@ impl Scene {
             stiffness: self.model.stiffness,
             bending_scale: self.model.bending_scale,
             fold: self.model.fold_barrier,
+            collapse: self.model.collapse_barrier,
         };
         let model = ElementModel::new(&material, &flags, self.psd);
         let mut pins = Vec::new();

@@ -17,7 +17,8 @@
 //!                                                // (N/m): each held vertex is a spring ½ k |x − target|²
 //!   "model": {"bending": true, "only_1d": false, "in_plane_only": false,
 //!             "stiffness": 1.0, "bending_scale": 1.0, "mass": 1.0,
-//!             "fold_barrier": {"angle": 2.5, "stiffness": 1.0}},   // null: none (`super::fold`)
+//!             "fold_barrier": {"angle": 2.5, "stiffness": 1.0},    // null: none (`super::fold`)
+//!             "collapse_barrier": {"area": 0.2, "stiffness": 1.0}}, // null: none (`super::fold`)
 //!   "psd": "full",                               // "full" (18×18), "psi" (6×6), "none" (diagonal shift)
 //!   "solver": {"force_tol": 1e-6, "max_newton": 50, "exact_first": true, "max_halvings": 6},
 //!   "pins": [{"near": {"point": [0, 0], "radius": 0.01}}],
@@ -37,7 +38,7 @@
 
 pub use super::dissipation::Wind;
 use super::element::{ElementModel, ModelFlags, Psd};
-pub use super::fold::FoldBarrier;
+pub use super::fold::{CollapseBarrier, FoldBarrier};
 use super::mesh::{load_obj_surface, write_obj, Mesh};
 use super::obstacle::{MeshObstacle, Obstacle};
 use super::solver::{Boundary, Handle, Settings, Simulation, StepReport};
@@ -237,6 +238,13 @@ pub struct ModelSpec {
     /// the fold barrier ([`FoldBarrier`]); on by default, `null` turns it off
     #[serde(default = "default_fold")]
     pub fold_barrier: Option<FoldBarrier>,
+    /// the collapse barrier ([`CollapseBarrier`]); on by default, `null` turns it off
+    #[serde(default = "default_collapse")]
+    pub collapse_barrier: Option<CollapseBarrier>,
+}
+
+fn default_collapse() -> Option<CollapseBarrier> {
+    Some(CollapseBarrier::default())
 }
 
 fn default_fold() -> Option<FoldBarrier> {
@@ -253,6 +261,7 @@ impl Default for ModelSpec {
             bending_scale: 1.0,
             mass: 1.0,
             fold_barrier: default_fold(),
+            collapse_barrier: default_collapse(),
         }
     }
 }

@@ -96,6 +96,9 @@ impl Scene {
         if let Some(Err((key, msg))) = m.fold_barrier.map(|f| f.check()) {
             return bad(&format!("model.fold_barrier.{key}"), msg);
         }
+        if let Some(Err((key, msg))) = m.collapse_barrier.map(|f| f.check()) {
+            return bad(&format!("model.collapse_barrier.{key}"), msg);
+        }
         if self.solver.force_tol.is_nan() || self.solver.force_tol <= 0.0 {
             return bad(
                 "solver.force_tol",

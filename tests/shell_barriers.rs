@@ -1,12 +1,12 @@
-//! The fold barrier (issue 18, `hylc::shell::fold`): a hinge approaching the flat fold (|θ| → π) costs unbounded
-//! energy and is pushed open; below the threshold nothing changes; the PSD options treat the barrier's Hessian as
-//! documented; the derivative harness's barrier row samples hinges beyond its threshold; scenes turn it off with
-//! `null`.
+//! The fold and collapse barriers (issue 18, `hylc::shell::fold`): a hinge approaching the flat fold (|θ| → π)
+//! or a triangle approaching zero area costs unbounded energy and is pushed back; below the thresholds nothing
+//! changes; the PSD options treat the fold barrier's Hessian as documented; the derivative harness's barrier
+//! rows sample states beyond their thresholds; scenes have both by default and turn them off with `null`.
 
 use hylc::checks::shell::sample_stencil;
 use hylc::material::synthetic::default_material;
 use hylc::shell::element::{ElementModel, ModelFlags, Psd};
-use hylc::shell::fold::FoldBarrier;
+use hylc::shell::fold::{CollapseBarrier, FoldBarrier};
 use hylc::shell::scene::Scene;
 use hylc::shell::strain::{RestTriangle, StrainChain, NDOF};
 use nalgebra::{DMatrix, SymmetricEigen};
@@ -37,6 +37,23 @@ fn model(fold: Option<FoldBarrier>, psd: Psd) -> ElementModel {
         ..ModelFlags::default()
     };
     ElementModel::new(&default_material(), &flags, psd)
+}
+
+fn collapsing(collapse: Option<CollapseBarrier>, psd: Psd) -> ElementModel {
+    let flags = ModelFlags {
+        collapse,
+        ..ModelFlags::default()
+    };
+    ElementModel::new(&default_material(), &flags, psd)
+}
+
+/// The flat triangle of [`folded`] (flap flat) sheared by moving x₂ along the fabric x axis by `t` legs: the
+/// area ratio stays 1 while s_a grows, so use `squash` to move it towards the edge (x₀, x₁) as well: J = 1 − squash.
+fn sheared(t: f64, squash: f64) -> ([f64; NDOF], RestTriangle, [bool; 3]) {
+    let (mut q, rest, flaps) = folded(0.0);
+    q[6] = 0.01 * t;
+    q[7] = 0.01 * (1.0 - squash);
+    (q, rest, flaps)
 }
 
 fn barrier() -> Option<FoldBarrier> {
@@ -205,6 +222,13 @@ fn scenes_have_the_barrier_by_default_and_null_turns_it_off() {
     let off: Scene =
         serde_json::from_str(&format!(r#"{base}, "model": {{"fold_barrier": null}}}}"#)).unwrap();
     assert_eq!(off.model.fold_barrier, None);
+    assert_eq!(on.model.collapse_barrier, Some(CollapseBarrier::default()));
+    let off: Scene = serde_json::from_str(&format!(
+        r#"{base}, "model": {{"collapse_barrier": null}}}}"#
+    ))
+    .unwrap();
+    assert_eq!(off.model.collapse_barrier, None);
+    assert_eq!(off.model.fold_barrier, Some(FoldBarrier::default()));
     let custom: Scene = serde_json::from_str(&format!(
         r#"{base}, "model": {{"fold_barrier": {{"angle": 2.0, "stiffness": 3.0}}}}}}"#
     ))
@@ -220,4 +244,74 @@ fn scenes_have_the_barrier_by_default_and_null_turns_it_off() {
         r#"{base}, "model": {{"fold_barrier": {{"angle": 2.0, "stifness": 3.0}}}}}}"#
     ));
     assert!(unknown.is_err());
+}
+
+#[test]
+fn a_triangle_cannot_collapse() {
+    let (with, without) = (
+        collapsing(Some(CollapseBarrier::default()), Psd::None),
+        collapsing(None, Psd::None),
+    );
+    let mut prev = f64::NEG_INFINITY;
+    for squash in [0.85, 0.9, 0.99, 1.0 - 1e-6] {
+        let (q, rest, flaps) = sheared(0.5, squash);
+        let e = with.energy(&q, &rest, flaps).unwrap();
+        let e0 = without.energy(&q, &rest, flaps).unwrap();
+        assert!(
+            e - e0 > prev,
+            "J = {}: the barrier must grow as the area goes",
+            1.0 - squash
+        );
+        prev = e - e0;
+        // the barrier's force pushes x₂ away from the edge (x₀, x₁): ∂E/∂y₂ < 0 beyond the material's own
+        let (mut g, mut g0) = ([0.0; NDOF], [0.0; NDOF]);
+        with.energy_gradient(&q, &rest, flaps, &mut g).unwrap();
+        without.energy_gradient(&q, &rest, flaps, &mut g0).unwrap();
+        assert!(g[7] - g0[7] < 0.0, "J = {}", 1.0 - squash);
+    }
+    let (q, rest, flaps) = sheared(0.5, 1.0);
+    assert!(with.energy(&q, &rest, flaps).is_none());
+}
+
+#[test]
+fn above_the_collapse_threshold_nothing_changes() {
+    for psd in [Psd::None, Psd::Psi, Psd::Full] {
+        let (with, without) = (
+            collapsing(Some(CollapseBarrier::default()), psd),
+            collapsing(None, psd),
+        );
+        for (t, squash) in [(0.0, 0.0), (0.9, 0.3), (0.3, 0.75)] {
+            let (q, rest, flaps) = sheared(t, squash);
+            let run = |m: &ElementModel| {
+                let (mut g, mut h) = ([0.0; NDOF], [[0.0; NDOF]; NDOF]);
+                let e = m
+                    .energy_gradient_hessian(&q, &rest, flaps, &mut g, &mut h)
+                    .unwrap()
+                    .0;
+                (m.energy(&q, &rest, flaps).unwrap(), e, g, h)
+            };
+            assert_eq!(
+                run(&with),
+                run(&without),
+                "{psd:?}, shear {t}, squash {squash}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_harness_row_samples_triangles_beyond_the_collapse_threshold() {
+    // the row `shell triangle energy with collapse barrier` uses J_t = 0.6
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let mut beyond = 0;
+    for i in 0..300 {
+        let (q, rest, flaps) = sample_stencil(&mut rng, i);
+        let z = StrainChain::new(&q, &rest, flaps).unwrap().z;
+        let j = (1.0 + z[0]) * (1.0 + z[2]) * (1.0 - z[1] * z[1]).sqrt();
+        beyond += usize::from(j < 0.6);
+    }
+    assert!(
+        beyond * 10 > 300,
+        "{beyond} of 300 triangles beyond the threshold"
+    );
 }
