@@ -93,6 +93,13 @@ impl HyError {
         Self::new(Kind::Value, message)
     }
 
+    /// An error about `file` of class `kind`, or `FileNotFoundError` when it is about the whole file
+    /// (`whole_file`: no line or field) and the file does not exist (the readers keep only the I/O error's text).
+    pub fn about_file(file: &str, whole_file: bool, kind: Kind, message: String) -> Self {
+        let missing = whole_file && !std::path::Path::new(file).exists();
+        Self::new(if missing { Kind::NotFound } else { kind }, message)
+    }
+
     /// A library error of class `kind`, or `FileNotFoundError` when its cause is a missing file.
     pub fn from_library(kind: Kind, e: &(dyn std::error::Error + 'static)) -> Self {
         let mut cause: Option<&(dyn std::error::Error + 'static)> = Some(e);
@@ -131,19 +138,10 @@ library_errors! {
 }
 
 impl From<hylc::pattern::PatternError> for HyError {
-    /// A pattern error without a block or line about a file that does not exist is a missing file (the reader
-    /// keeps only the I/O error's text).
+    /// A pattern error without a block or line about a file that does not exist is a missing file.
     fn from(e: hylc::pattern::PatternError) -> Self {
-        let missing =
-            e.block.is_none() && e.line.is_none() && !std::path::Path::new(&e.file).exists();
-        HyError::new(
-            if missing {
-                Kind::NotFound
-            } else {
-                Kind::Pattern
-            },
-            e.to_string(),
-        )
+        let whole_file = e.block.is_none() && e.line.is_none();
+        HyError::about_file(&e.file, whole_file, Kind::Pattern, e.to_string())
     }
 }
 
@@ -161,15 +159,7 @@ impl From<hylc::micro::MicroError> for HyError {
 impl From<hylc::material::MaterialError> for HyError {
     /// A material file that cannot be read because it does not exist is a missing file.
     fn from(e: hylc::material::MaterialError) -> Self {
-        let missing = e.field == "(file)" && !std::path::Path::new(&e.file).exists();
-        HyError::new(
-            if missing {
-                Kind::NotFound
-            } else {
-                Kind::Material
-            },
-            e.to_string(),
-        )
+        HyError::about_file(&e.file, e.field == "(file)", Kind::Material, e.to_string())
     }
 }
 

@@ -14,6 +14,14 @@ mod yarn;
 
 use pyo3::prelude::*;
 
+/// Test hook: panics inside the boundary, which must raise `hylc.InternalError` (never abort the interpreter).
+#[pyfunction]
+fn _panic_at_the_boundary(py: Python<'_>) -> PyResult<()> {
+    errors::detached(py, || -> errors::HyResult<()> {
+        panic!("a panic raised on purpose")
+    })
+}
+
 #[pymodule]
 fn _hylc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
@@ -30,6 +38,7 @@ fn _hylc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(yarn::save_yarn, m)?)?;
     m.add_function(wrap_pyfunction!(material::fit, m)?)?;
     m.add_function(wrap_pyfunction!(cloth::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_at_the_boundary, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -3,9 +3,8 @@
 use crate::convert::report;
 use crate::errors::{detached, HyError};
 use crate::yarn::yarn_of;
-use hylc::micro::reference::{reference_state as c1, Construction, ReferenceOptions};
-use hylc::micro::SolverOptions;
-use hylc::workflow::inputs::{construction_of, load_pattern as load_arg};
+use hylc::micro::reference::Construction;
+use hylc::workflow::inputs::{load_pattern as load_arg, reference_of};
 use numpy::PyArray2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -217,23 +216,14 @@ pub fn reference_state<'py>(
             .into())
         }
     };
-    let construction = match given {
-        None if equilibrate_only => Construction::Woven,
-        given => construction_of(&p.source, given).map_err(HyError::from)?,
-    };
-    let source = p.source.clone();
-    let (q, rep) = detached(py, || {
-        c1(
+    let (q, rep, _) = detached(py, || {
+        Ok(reference_of(
+            &p.source,
             &p.inner,
             &yarn,
-            construction,
-            &SolverOptions::default(),
-            &ReferenceOptions {
-                stress_free_and_tension: !equilibrate_only,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| HyError::new(crate::errors::Kind::Micro, format!("{source}: {e}")))
+            given,
+            equilibrate_only,
+        )?)
     })?;
     Ok((PyPattern::new(q, &p.source, Vec::new()), report(py, &rep)?))
 }

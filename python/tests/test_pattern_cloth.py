@@ -105,3 +105,12 @@ def test_import_exposes_the_api():
         assert getattr(hylc, name) is not None
     assert "numpy arrays" in hylc.__doc__ or "(N, 6)" in hylc.__doc__
     assert hylc.MicroProblem.solve.__doc__ and hylc.Material.psi.__doc__
+
+
+def test_a_panic_becomes_an_internal_error():
+    from hylc import _hylc
+
+    with pytest.raises(hylc.InternalError, match="internal error: a panic raised on purpose"):
+        _hylc._panic_at_the_boundary()
+    # the interpreter goes on
+    assert hylc.Material.default().psi([0.0] * 6) == hylc.Material.default().psi(np.zeros(6))
