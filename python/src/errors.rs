@@ -93,6 +93,12 @@ impl HyError {
         Self::new(Kind::Value, message)
     }
 
+    /// The error with `prefix` before its message.
+    pub fn with_prefix(mut self, prefix: &str) -> Self {
+        self.message = format!("{prefix}{}", self.message);
+        self
+    }
+
     /// An error about `file` of class `kind`, or `FileNotFoundError` when it is about the whole file
     /// (`whole_file`: no line or field) and the file does not exist (the readers keep only the I/O error's text).
     pub fn about_file(file: &str, whole_file: bool, kind: Kind, message: String) -> Self {

@@ -162,14 +162,6 @@ impl PyMaterial {
     }
 }
 
-impl HyError {
-    /// The error with `prefix` before its message.
-    pub fn with_prefix(mut self, prefix: &str) -> Self {
-        self.message = format!("{prefix}{}", self.message);
-        self
-    }
-}
-
 /// Fit a material to a sample file (Algorithm C5, as `hylc fit SAMPLES` with its defaults): writes the material
 /// JSON (`out`, default SAMPLES with extension .material.json) and the JSON fit report (`report`, default
 /// .fit.json), PNG plots only when `plots` (a folder) is given. Returns (Material, report dict).

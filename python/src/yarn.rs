@@ -13,11 +13,7 @@ pub fn yarn_of(arg: Option<&Bound<'_, PyAny>>) -> HyResult<YarnMaterial> {
         return Ok(YarnMaterial::default());
     };
     if let Ok(path) = obj.extract::<std::path::PathBuf>() {
-        return YarnMaterial::load_json(&path).map_err(|e| {
-            let mut err = HyError::from(e);
-            err.message = format!("yarn: {}", err.message);
-            err
-        });
+        return YarnMaterial::load_json(&path).map_err(|e| HyError::from(e).with_prefix("yarn: "));
     }
     let dict = obj.cast::<PyDict>().map_err(|_| {
         HyError::value("yarn: expected a dict of yarn parameters, a file path or None")
