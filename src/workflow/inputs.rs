@@ -3,8 +3,10 @@
 
 use super::WorkflowError;
 use crate::generate::default_pattern;
-use crate::micro::reference::Construction;
+use crate::micro::reference::{reference_state, Construction, ReferenceOptions, ReferenceReport};
+use crate::micro::SolverOptions;
 use crate::pattern::Pattern;
+use crate::rod::YarnMaterial;
 use crate::sample::Plan;
 use std::path::Path;
 
@@ -62,6 +64,38 @@ pub fn construction_of(
         None if arg == "stockinette" => Ok(Construction::Knitted),
         None => Ok(Construction::Woven),
     }
+}
+
+/// The reference state (C1) of the pattern argument `arg` as `hylc reference` computes it, with the default solver
+/// options: the construction given, else [`construction_of`] the argument (woven when `equilibrate_only`, which skips
+/// the stress-free state and the tension). Returns the state, C1's report and the construction used.
+pub fn reference_of(
+    arg: &str,
+    pattern: &Pattern,
+    yarn: &YarnMaterial,
+    given: Option<Construction>,
+    equilibrate_only: bool,
+) -> Result<(Pattern, ReferenceReport, Construction), WorkflowError> {
+    let construction = match given {
+        None if equilibrate_only => Construction::Woven,
+        given => construction_of(arg, given)?,
+    };
+    let options = ReferenceOptions {
+        stress_free_and_tension: !equilibrate_only,
+        ..Default::default()
+    };
+    let (q, report) = reference_state(
+        pattern,
+        yarn,
+        construction,
+        &SolverOptions::default(),
+        &options,
+    )
+    .map_err(|source| WorkflowError::Reference {
+        pattern: arg.to_string(),
+        source,
+    })?;
+    Ok((q, report, construction))
 }
 
 /// A plan by name (`default`, `reduced`, `quick`, `holdout`) or JSON file.

@@ -1,10 +1,7 @@
 //! `hylc generate KIND`: a yarn pattern made procedurally (`hylc::generate`; `02-yarn-model.md`).
 
 use anyhow::anyhow;
-use hylc::generate::{
-    min_centerline_distance, stockinette, to_obj, weave, KnitParams, SameYarn, WeaveParams,
-    DEFAULT_KINDS,
-};
+use hylc::generate::{generate_kind, min_centerline_distance, to_obj, SameYarn};
 use hylc::pattern::Pattern;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -34,36 +31,8 @@ pub struct Args {
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let (kind, n, step, vertices_per_radius) =
         (a.kind.as_str(), a.n, a.step, a.vertices_per_radius);
-    let weave_params = match kind {
-        "plain" => Some(WeaveParams::plain()),
-        "twill" => Some(WeaveParams::twill(n.unwrap_or(4))),
-        "satin" => Some(WeaveParams::satin(n.unwrap_or(5), step.unwrap_or(2))),
-        "basket" => Some(WeaveParams::basket(n.unwrap_or(2))),
-        "stockinette" => None,
-        _ => {
-            anyhow::bail!(
-                "unknown pattern kind {kind:?} (expected one of {})",
-                DEFAULT_KINDS.join(", ")
-            )
-        }
-    };
-    if n.is_some() && !matches!(kind, "twill" | "satin" | "basket") {
-        anyhow::bail!("--n does not apply to {kind}");
-    }
-    if step.is_some() && kind != "satin" {
-        anyhow::bail!("--step applies to satin only, not {kind}");
-    }
-    let pattern: Pattern = match weave_params {
-        Some(params) => weave(&WeaveParams {
-            vertices_per_radius,
-            ..params
-        }),
-        None => stockinette(&KnitParams {
-            vertices_per_radius,
-            ..KnitParams::stockinette()
-        }),
-    }
-    .map_err(|e| anyhow!("generate {kind}: {e}"))?;
+    let pattern: Pattern = generate_kind(kind, n, step, vertices_per_radius)
+        .map_err(|e| anyhow!("generate {kind}: {e}"))?;
     let r = pattern.radius;
     let yarns = pattern.yarns();
     let lengths: Vec<f64> = pattern.edges.iter().map(|e| e.rest_length).collect();

@@ -3,10 +3,7 @@
 
 use crate::args::{ConstructionArg, OutputArgs, YarnArgs};
 use crate::strain::load_pattern_noted;
-use anyhow::anyhow;
-use hylc::micro::reference::{reference_state, Construction, ReferenceOptions};
-use hylc::micro::SolverOptions;
-use hylc::workflow::inputs::construction_of;
+use hylc::workflow::inputs::reference_of;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -36,21 +33,13 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let (pattern, equilibrate_only, out) = (a.pattern.as_str(), a.equilibrate_only, &a.out);
     let yarn = a.yarn.material()?;
     let p = load_pattern_noted(pattern)?;
-    let construction = match a.construction {
-        None if equilibrate_only => Construction::Woven,
-        given => construction_of(pattern, given.map(Into::into))?,
-    };
-    let (q, report) = reference_state(
+    let (q, report, construction) = reference_of(
+        pattern,
         &p,
         &yarn,
-        construction,
-        &SolverOptions::default(),
-        &ReferenceOptions {
-            stress_free_and_tension: !equilibrate_only,
-            ..Default::default()
-        },
-    )
-    .map_err(|e| anyhow!("{pattern}: {e}"))?;
+        a.construction.map(Into::into),
+        equilibrate_only,
+    )?;
     q.save_pyp(out)?;
     println!(
         "{pattern} ({}): {} stress-free round(s) (relaxed energy {:.2e} J); zero-stress periods \

@@ -1,0 +1,116 @@
+"""Patterns, the reference state and cloth scenes from Python against the CLI; bad input raises."""
+
+import json
+
+import numpy as np
+import pytest
+
+import hylc
+
+
+def test_generate_equals_the_cli(tmp_path, cli):
+    for kind, extra in [("plain", []), ("twill", ["--n", "3"]), ("stockinette", [])]:
+        cli("generate", kind, *extra, "--out", tmp_path / f"{kind}.cli.pyp")
+        n = int(extra[1]) if extra else None
+        p = hylc.generate(kind, n=n)
+        p.save(tmp_path / f"{kind}.py.pyp")
+        assert (tmp_path / f"{kind}.py.pyp").read_bytes() == (tmp_path / f"{kind}.cli.pyp").read_bytes()
+
+
+def test_load_save_and_summary(tmp_path, cli):
+    p = hylc.generate("plain")
+    path = tmp_path / "plain.pyp"
+    p.save(path)
+    q = hylc.read_pyp(path)
+    np.testing.assert_array_equal(q.positions, p.positions)
+    assert q.periods == p.periods and q.radius == p.radius
+    s = q.summary()
+    text = cli("pattern", path).stdout
+    assert f"vertices: {s['vertices']} " in text
+    assert f"yarns: {len(s['yarns'])}" in text
+    assert len(p) == 40 and p.positions.shape == (40, 3)
+    assert sorted(v for y in p.yarns() for v in y) == list(range(40))
+    r = hylc.load_pattern(str(path))
+    np.testing.assert_array_equal(r.positions, p.positions)
+
+
+def test_reference_state_equals_the_cli(tmp_path, cli):
+    cli("reference", "plain", "--out", tmp_path / "cli.pyp", "--json", tmp_path / "cli.json")
+    q, report = hylc.reference_state("plain")
+    q.save(tmp_path / "py.pyp")
+    assert (tmp_path / "py.pyp").read_bytes() == (tmp_path / "cli.pyp").read_bytes()
+    expected = json.loads((tmp_path / "cli.json").read_text())
+    assert report["psi"] == expected["psi"]
+    assert report["periods_out"] == expected["periods_out"]
+
+
+def test_pattern_errors_have_the_cli_messages(tmp_path, cli):
+    with pytest.raises(FileNotFoundError, match="missing.pyp"):
+        hylc.load_pattern("missing.pyp")
+    with pytest.raises(hylc.PatternError) as e:
+        hylc.generate("jersey")
+    err = cli("generate", "jersey", check=False).stderr.strip()
+    assert err == f"error: {e.value}"
+    bad = tmp_path / "bad.pyp"
+    bad.write_text("*not a pattern\n")
+    with pytest.raises(hylc.PatternError) as e:
+        hylc.read_pyp(bad)
+    err = cli("pattern", bad, check=False).stderr.strip()
+    assert err == f"error: {e.value}"
+    with pytest.raises(ValueError, match="construction"):
+        hylc.reference_state("plain", construction="crochet")
+    with pytest.raises(ValueError, match="pass --construction"):
+        hylc.reference_state(_saved_plain(tmp_path))
+    with pytest.raises(ValueError, match="pattern: expected a Pattern"):
+        hylc.MicroProblem(42)
+
+
+def _saved_plain(tmp_path):
+    path = tmp_path / "plain.pyp"
+    hylc.generate("plain").save(path)
+    return str(path)
+
+
+def test_simulate_equals_the_cli_log(tmp_path, cli):
+    out = tmp_path / "cli"
+    cli("simulate", "stretch-x", "--duration", "0.05", "--out", out, "--quiet")
+    log = [json.loads(line) for line in (out / "log.jsonl").read_text().splitlines()]
+    r = hylc.simulate("stretch-x", duration=0.05)
+    assert len(r["step"]) == len(log) == r["summary"]["steps"]
+    for key in ["time", "newton", "residual", "energy_elastic", "energy_kinetic", "energy_gravity"]:
+        np.testing.assert_allclose(r[key], [e[key] for e in log], rtol=1e-9, atol=1e-300)
+    np.testing.assert_allclose(r["strain_max"], [e["strain_max"] for e in log], rtol=1e-9, atol=1e-15)
+    for name, forces in r["handle_forces"].items():
+        expected = [dict(map(tuple, [(h[0], h[1]) for h in e["handle_forces"]]))[name] for e in log]
+        np.testing.assert_allclose(forces, expected, rtol=1e-8, atol=1e-12)
+    assert r["positions"].shape == (r["summary"]["vertices"], 3)
+    assert r["triangles"].shape == (r["summary"]["triangles"], 3) and r["triangles"].dtype == np.int64
+    assert r["triangles"].max() < r["summary"]["vertices"]
+
+
+def test_simulate_bad_input_raises(tmp_path):
+    with pytest.raises(FileNotFoundError, match="scene: missing.json"):
+        hylc.simulate("missing.json")
+    with pytest.raises(hylc.SimulationError, match="not a built-in scene"):
+        hylc.simulate("no-such-scene")
+    with pytest.raises(ValueError, match="--dt"):
+        hylc.simulate("stretch-x", dt=-1.0)
+
+
+def test_import_exposes_the_api():
+    assert issubclass(hylc.PatternError, hylc.Error)
+    assert issubclass(hylc.InternalError, hylc.Error)
+    assert hylc.__version__
+    for name in hylc.__all__:
+        assert getattr(hylc, name) is not None
+    assert "numpy arrays" in hylc.__doc__ or "(N, 6)" in hylc.__doc__
+    assert hylc.MicroProblem.solve.__doc__ and hylc.Material.psi.__doc__
+
+
+def test_a_panic_becomes_an_internal_error():
+    from hylc import _hylc
+
+    with pytest.raises(hylc.InternalError, match="internal error: a panic raised on purpose"):
+        _hylc._panic_at_the_boundary()
+    # the interpreter goes on
+    assert hylc.Material.default().psi([0.0] * 6) == hylc.Material.default().psi(np.zeros(6))
