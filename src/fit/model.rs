@@ -52,6 +52,9 @@ pub struct FitOptions {
     /// fit each 1D term to every `thin_1d`-th sample of its range only (default 1: all); the term's model error
     /// is still measured on the whole range, so the other samples are held out (a sampling-density study)
     pub thin_1d: usize,
+    /// FIT2D step 7′ instead of 7 on the pairs with one stretch axis ([`Fit2DOptions::compression_residual`];
+    /// default false: the design's zero-compression residual)
+    pub compression_residual: bool,
 }
 
 impl Default for FitOptions {
@@ -68,6 +71,7 @@ impl Default for FitOptions {
             slopes: SlopeSource::FiniteDifference,
             thin_1d: 1,
             strict_patches: true,
+            compression_residual: false,
         }
     }
 }
@@ -137,6 +141,10 @@ pub struct Term1DReport {
     pub model: ModelError,
 }
 
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
 /// One 2D term's report.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Term2DReport {
@@ -151,6 +159,9 @@ pub struct Term2DReport {
     pub twist_rounds: usize,
     pub slope_rounds: usize,
     pub nonmonotone_patches: usize,
+    /// patches of the compressed block failing FIT2D step 7′ (only with `compression_residual`)
+    #[serde(skip_serializing_if = "is_zero")]
+    pub compression_nonmonotone: usize,
     /// the whole model ψ on this plane
     pub model: ModelError,
 }
@@ -463,6 +474,7 @@ fn options_2d(k0: usize, k1: usize, opts: &FitOptions) -> Fit2DOptions {
         stretch: [stretch(k0), stretch(k1)],
         fd_step: 1e-3,
         strict_patches: opts.strict_patches,
+        compression_residual: opts.compression_residual,
     }
 }
 
@@ -562,6 +574,7 @@ fn term_reports(
             twist_rounds: f.report.twist_rounds,
             slope_rounds: f.report.slope_rounds,
             nonmonotone_patches: f.report.nonmonotone_patches,
+            compression_nonmonotone: f.report.compression_nonmonotone,
             model: model_error(material, by_index.in_range(plan.range_2d(p))),
         })
         .collect();
@@ -614,6 +627,11 @@ fn meta_block(
             "strict_patches": opts.strict_patches,
         }),
     );
+    if opts.compression_residual {
+        if let Some(serde_json::Value::Object(o)) = meta.get_mut("fit options") {
+            o.insert("compression_residual".into(), serde_json::json!(true));
+        }
+    }
     meta.insert(
         "fit errors".into(),
         serde_json::json!({
