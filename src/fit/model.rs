@@ -55,6 +55,10 @@ pub struct FitOptions {
     /// FIT2D step 7′ instead of 7 on the pairs with one stretch axis ([`Fit2DOptions::compression_residual`];
     /// default false: the design's zero-compression residual)
     pub compression_residual: bool,
+    /// symmetrise the MLS of every term in s_a (default true, the design's FIT1D/FIT2D step 1: Ψ̄ even in s_a);
+    /// false fits the two signs of shear separately (the knits' Ψ̄ is not even: honeycomb's rest state carries a
+    /// shear stress, and its Ψ̄ at s_a = ±0.75 is 3.43 against 2.31 J/m²)
+    pub symmetric_shear: bool,
 }
 
 impl Default for FitOptions {
@@ -72,6 +76,7 @@ impl Default for FitOptions {
             thin_1d: 1,
             strict_patches: true,
             compression_residual: false,
+            symmetric_shear: true,
         }
     }
 }
@@ -375,7 +380,7 @@ fn options_1d(k: usize, opts: &FitOptions) -> Fit1DOptions {
         bandwidth_factor: opts.bandwidth_factor,
         eps_rel: opts.eps_rel,
         min_slope: opts.min_slope,
-        symmetric: k == 1,
+        symmetric: k == 1 && opts.symmetric_shear,
         minimum: if k < 3 {
             MinimumAt::Zero
         } else {
@@ -464,7 +469,10 @@ fn options_2d(k0: usize, k1: usize, opts: &FitOptions) -> Fit2DOptions {
         bandwidth_factor: opts.bandwidth_factor,
         eps_rel: opts.eps_rel,
         min_slope: opts.min_slope,
-        symmetric: [k0 == 1, k1 == 1],
+        symmetric: [
+            k0 == 1 && opts.symmetric_shear,
+            k1 == 1 && opts.symmetric_shear,
+        ],
         quasi_convex: !(k0 == 0 && k1 == 2),
         minimum_v: if k1 < 3 {
             MinimumAt::Zero
@@ -627,9 +635,13 @@ fn meta_block(
             "strict_patches": opts.strict_patches,
         }),
     );
-    if opts.compression_residual {
-        if let Some(serde_json::Value::Object(o)) = meta.get_mut("fit options") {
+    // the options of issue 19 appear only when set, so a default fit's meta block stays as it was
+    if let Some(serde_json::Value::Object(o)) = meta.get_mut("fit options") {
+        if opts.compression_residual {
             o.insert("compression_residual".into(), serde_json::json!(true));
+        }
+        if !opts.symmetric_shear {
+            o.insert("symmetric_shear".into(), serde_json::json!(false));
         }
     }
     meta.insert(
