@@ -5,6 +5,7 @@
 //! residual on the tension side, is C¹ across every knot line, and never lies below the default residual (so
 //! ψ with it is ≥ ψ without it, which is ≥ f₀) on 10⁵ random points of a box three times the knot box.
 
+use crate::fit2d::dense;
 use hylc::fit::{fit2d, Fit2DOptions, MinimumAt};
 use hylc::material::Hermite2D;
 use proptest::prelude::*;
@@ -88,15 +89,6 @@ fn case() -> impl Strategy<Value = Case> {
                 Case { x, y, psi, opts }
             },
         )
-}
-
-/// `n + 1` points from 50 % beyond the first knot to 50 % beyond the last.
-fn dense(t: &[f64], n: usize) -> Vec<f64> {
-    let (a, b) = (t[0], t[t.len() - 1]);
-    let (lo, hi) = (a - 0.5 * (b - a), b + 0.5 * (b - a));
-    (0..=n)
-        .map(|i| lo + (hi - lo) * i as f64 / n as f64)
-        .collect()
 }
 
 /// r as a function of (stretch coordinate, other coordinate).

@@ -36,11 +36,14 @@ fn write_samples(
     write_samples_of(path, plan, &f, failed, density);
 }
 
+/// Ψ̄ and its gradient at a six-component strain.
+type Truth<'a> = &'a dyn Fn(&[f64; 6]) -> (f64, [f64; 6]);
+
 /// [`write_samples`] with Ψ̄ and its gradient given by `truth`.
 fn write_samples_of(
     path: &Path,
     plan: &Plan,
-    truth: &dyn Fn(&[f64; 6]) -> (f64, [f64; 6]),
+    truth: Truth,
     failed: &[usize],
     density: Option<f64>,
 ) {
@@ -79,6 +82,16 @@ fn write_samples_of(
     }
 }
 
+/// 150-sample 1D ranges, 20 × 20 grids on all nine pairs and the held-out 9×9×9 in-plane grid.
+fn dense_plan() -> Plan {
+    Plan {
+        count_1d: 150,
+        count_2d: 20,
+        grid: Some(InPlaneGrid::original()),
+        ..Plan::default()
+    }
+}
+
 fn report(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
@@ -87,12 +100,7 @@ fn report(path: &Path) -> serde_json::Value {
 fn fit_recovers_a_known_material_from_its_samples() {
     let d = dir("recover");
     let truth = default_material();
-    let plan = Plan {
-        count_1d: 150,
-        count_2d: 20,
-        grid: Some(InPlaneGrid::original()),
-        ..Plan::default()
-    };
+    let plan = dense_plan();
     let samples = d.join("s.jsonl");
     // two failed samples: one on the s_y range, one on the (s_x, s_a) grid
     let failed = [2 * 150 + 7, 5 * 150 + 33];
@@ -171,12 +179,7 @@ fn compression_residual_predicts_a_coupled_truth_and_only_adds_energy() {
         g[1] += c * 2.0 * (cx * cx + cy * cy) * a;
         (e.value + c * (cx * cx + cy * cy) * a * a, g)
     };
-    let plan = Plan {
-        count_1d: 150,
-        count_2d: 20,
-        grid: Some(InPlaneGrid::original()),
-        ..Plan::default()
-    };
+    let plan = dense_plan();
     let samples = d.join("s.jsonl");
     write_samples_of(&samples, &plan, &truth, &[], Some(0.25));
     let fit = |name: &str, extra: &[&str]| {

@@ -23,7 +23,7 @@
 //! compressed half-plane and beyond the knots (constant there): added to the 1D terms it raises ψ where the
 //! samples couple, and never lowers it below f₀.
 
-use super::{limit_line, outward, Grid, PatchRounds};
+use super::{outward, Grid, PatchRounds};
 
 /// The compressed block of a residual grid, as a grid of its own with the stretch axis first (u) and the zero
 /// lines at its last column (u = 0) and at row `j0`.
@@ -91,30 +91,6 @@ impl Grid {
             }
         }
     }
-
-    /// Whether patch `(ci, cj)` fails the outward monotonicity certificate along u (sign `su`) and along v (sign
-    /// `sv`), `None` for a direction not checked; see [`Grid::failing_patches`].
-    pub(super) fn patch_fails(
-        &self,
-        cell: (usize, usize),
-        su: Option<f64>,
-        sv: Option<f64>,
-        tol: f64,
-    ) -> (bool, bool) {
-        let net = self.bezier_net(cell);
-        let mut du = [[0.0; 4]; 3];
-        let mut dv = [[0.0; 4]; 3];
-        for a in 0..3 {
-            for b in 0..4 {
-                du[a][b] = su.unwrap_or(0.0) * 3.0 * (net[a + 1][b] - net[a][b]);
-                dv[a][b] = sv.unwrap_or(0.0) * 3.0 * (net[b][a + 1] - net[b][a]);
-            }
-        }
-        (
-            su.is_some() && !super::nonnegative(&du, tol),
-            sv.is_some() && !super::nonnegative(&dv, tol),
-        )
-    }
 }
 
 impl Block {
@@ -148,43 +124,8 @@ impl Block {
                 g.p[k] = v;
             }
         }
-        for j in 0..nv {
-            let k = g.at(0, j);
-            g.mu[k] = 0.0;
-            g.muv[k] = 0.0;
-        }
-        for i in 0..nu {
-            for j in [0, nv - 1] {
-                let k = g.at(i, j);
-                g.mv[k] = 0.0;
-                g.muv[k] = 0.0;
-            }
-        }
-    }
-
-    /// Step 4, grid lines: Fritsch–Carlson along every row and column (no knot exempt: the zero lines' slopes
-    /// are 0).
-    fn limit(&mut self) {
-        let g = &mut self.grid;
-        let (nu, nv) = (g.tu.len(), g.tv.len());
-        for j in 0..nv {
-            let ks: Vec<usize> = (0..nu).map(|i| g.at(i, j)).collect();
-            let p: Vec<f64> = ks.iter().map(|&k| g.p[k]).collect();
-            let mut m: Vec<f64> = ks.iter().map(|&k| g.mu[k]).collect();
-            limit_line(&g.tu, &p, &mut m, None);
-            for (&k, v) in ks.iter().zip(m) {
-                g.mu[k] = v;
-            }
-        }
-        for i in 0..nu {
-            let ks: Vec<usize> = (0..nv).map(|j| g.at(i, j)).collect();
-            let p: Vec<f64> = ks.iter().map(|&k| g.p[k]).collect();
-            let mut m: Vec<f64> = ks.iter().map(|&k| g.mv[k]).collect();
-            limit_line(&g.tv, &p, &mut m, None);
-            for (&k, v) in ks.iter().zip(m) {
-                g.mv[k] = v;
-            }
-        }
+        // step 3: step 8 on the block (its last column is zero already)
+        g.bound_extrapolation();
     }
 
     /// The patches failing the outward certificate: along u towards −u everywhere, along v away from row j0.
@@ -281,7 +222,9 @@ impl Grid {
             j0: r0,
         };
         block.raise();
-        block.limit();
+        // step 4, grid lines: Fritsch–Carlson along every row and column, no knot exempt (the zero lines'
+        // slopes are 0)
+        block.grid.limit_lines(None, None);
         let rounds = block.monotone_patches();
         work.put_left_block(&block.grid);
         *self = if transpose { work.transposed() } else { work };

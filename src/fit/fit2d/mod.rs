@@ -291,19 +291,8 @@ impl Grid {
                 if !(check_x || check_y) {
                     continue;
                 }
-                let net = self.bezier_net((ci, cj));
-                // Bernstein coefficients of the outward derivative, first index along the derivative
-                // (degree 2), second across it (degree 3)
-                let mut du = [[0.0; 4]; 3];
-                let mut dv = [[0.0; 4]; 3];
-                for a in 0..3 {
-                    for b in 0..4 {
-                        du[a][b] = sx * 3.0 * (net[a + 1][b] - net[a][b]);
-                        dv[a][b] = sy * 3.0 * (net[b][a + 1] - net[b][a]);
-                    }
-                }
-                let fx = check_x && !nonnegative(&du, tol);
-                let fy = check_y && !nonnegative(&dv, tol);
+                let (fx, fy) =
+                    self.patch_fails((ci, cj), check_x.then_some(sx), check_y.then_some(sy), tol);
                 if fx || fy {
                     out.push(Failing {
                         cell: (ci, cj),
@@ -314,6 +303,31 @@ impl Grid {
             }
         }
         out
+    }
+
+    /// Whether patch `(ci, cj)` fails the outward monotonicity certificate along u (sign `su`) and along v (sign
+    /// `sv`), `None` for a direction not checked; the Bernstein coefficients of
+    /// the outward derivative have their first index along the derivative (degree 2), the second across (degree 3).
+    fn patch_fails(
+        &self,
+        cell: (usize, usize),
+        su: Option<f64>,
+        sv: Option<f64>,
+        tol: f64,
+    ) -> (bool, bool) {
+        let net = self.bezier_net(cell);
+        let mut du = [[0.0; 4]; 3];
+        let mut dv = [[0.0; 4]; 3];
+        for a in 0..3 {
+            for b in 0..4 {
+                du[a][b] = su.unwrap_or(0.0) * 3.0 * (net[a + 1][b] - net[a][b]);
+                dv[a][b] = sv.unwrap_or(0.0) * 3.0 * (net[b][a + 1] - net[b][a]);
+            }
+        }
+        (
+            su.is_some() && !nonnegative(&du, tol),
+            sv.is_some() && !nonnegative(&dv, tol),
+        )
     }
 }
 
