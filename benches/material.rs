@@ -2,6 +2,9 @@
 //! about 3.7 µs on this machine kind), for the original basket1 and stock1 and the embedded default material.
 //! Baselines measured in the same run: the value alone, and the same derivatives by num-dual automatic
 //! differentiation of the generic reference implementation. Time per iteration covers 64 strains.
+//!
+//! `HYLC_BENCH_MATERIALS=name=path,name=path` adds material files (e.g. a base fit and its extended variants, issue
+//! 19's candidate table, whose cost ratios are taken within one run).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hylc::checks::material::PsiCheck;
@@ -74,6 +77,30 @@ fn benches(c: &mut Criterion) {
         eprintln!("note: ../shared not found; benchmarking the embedded default material only");
     }
     bench_material(c, "default", default_material());
+    for (name, path) in extra_materials() {
+        match Material::load(std::path::Path::new(&path)) {
+            Ok(m) => bench_material(c, &name, m),
+            Err(e) => eprintln!("note: {path}: {e}; not benchmarked"),
+        }
+    }
+}
+
+/// The `name=path` pairs of `HYLC_BENCH_MATERIALS` (a path alone is named by its file name).
+fn extra_materials() -> Vec<(String, String)> {
+    std::env::var("HYLC_BENCH_MATERIALS")
+        .unwrap_or_default()
+        .split(',')
+        .filter(|s| !s.is_empty())
+        .map(|s| match s.split_once('=') {
+            Some((n, p)) => (n.to_string(), p.to_string()),
+            None => (
+                std::path::Path::new(s)
+                    .file_name()
+                    .map_or(s.to_string(), |f| f.to_string_lossy().into_owned()),
+                s.to_string(),
+            ),
+        })
+        .collect()
 }
 
 criterion_group! {

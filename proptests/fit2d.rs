@@ -140,7 +140,7 @@ fn check_line(v: &[f64], what: &str) -> Result<(), TestCaseError> {
 }
 
 /// A dense grid from 50 % beyond the first knot to 50 % beyond the last.
-fn dense(t: &[f64], n: usize) -> Vec<f64> {
+pub(crate) fn dense(t: &[f64], n: usize) -> Vec<f64> {
     let (a, b) = (t[0], t[t.len() - 1]);
     let (lo, hi) = (a - 0.5 * (b - a), b + 0.5 * (b - a));
     (0..=n)

@@ -8,6 +8,7 @@
 mod contact;
 mod fit;
 mod fit2d;
+mod fit2d_compression;
 mod micro;
 mod rod;
 

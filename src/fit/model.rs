@@ -52,6 +52,13 @@ pub struct FitOptions {
     /// fit each 1D term to every `thin_1d`-th sample of its range only (default 1: all); the term's model error
     /// is still measured on the whole range, so the other samples are held out (a sampling-density study)
     pub thin_1d: usize,
+    /// FIT2D step 7′ instead of 7 on the pairs with one stretch axis ([`Fit2DOptions::compression_residual`];
+    /// default false: the design's zero-compression residual)
+    pub compression_residual: bool,
+    /// symmetrise the MLS of every term in s_a (default true, the design's FIT1D/FIT2D step 1: Ψ̄ even in s_a);
+    /// false fits the two signs of shear separately (the knits' Ψ̄ is not even: honeycomb's rest state carries a
+    /// shear stress, and its Ψ̄ at s_a = ±0.75 is 3.43 against 2.31 J/m²)
+    pub symmetric_shear: bool,
 }
 
 impl Default for FitOptions {
@@ -68,6 +75,8 @@ impl Default for FitOptions {
             slopes: SlopeSource::FiniteDifference,
             thin_1d: 1,
             strict_patches: true,
+            compression_residual: false,
+            symmetric_shear: true,
         }
     }
 }
@@ -137,6 +146,10 @@ pub struct Term1DReport {
     pub model: ModelError,
 }
 
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
 /// One 2D term's report.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Term2DReport {
@@ -151,6 +164,9 @@ pub struct Term2DReport {
     pub twist_rounds: usize,
     pub slope_rounds: usize,
     pub nonmonotone_patches: usize,
+    /// patches of the compressed block failing FIT2D step 7′ (only with `compression_residual`)
+    #[serde(skip_serializing_if = "is_zero")]
+    pub compression_nonmonotone: usize,
     /// the whole model ψ on this plane
     pub model: ModelError,
 }
@@ -364,7 +380,7 @@ fn options_1d(k: usize, opts: &FitOptions) -> Fit1DOptions {
         bandwidth_factor: opts.bandwidth_factor,
         eps_rel: opts.eps_rel,
         min_slope: opts.min_slope,
-        symmetric: k == 1,
+        symmetric: k == 1 && opts.symmetric_shear,
         minimum: if k < 3 {
             MinimumAt::Zero
         } else {
@@ -453,7 +469,10 @@ fn options_2d(k0: usize, k1: usize, opts: &FitOptions) -> Fit2DOptions {
         bandwidth_factor: opts.bandwidth_factor,
         eps_rel: opts.eps_rel,
         min_slope: opts.min_slope,
-        symmetric: [k0 == 1, k1 == 1],
+        symmetric: [
+            k0 == 1 && opts.symmetric_shear,
+            k1 == 1 && opts.symmetric_shear,
+        ],
         quasi_convex: !(k0 == 0 && k1 == 2),
         minimum_v: if k1 < 3 {
             MinimumAt::Zero
@@ -463,6 +482,7 @@ fn options_2d(k0: usize, k1: usize, opts: &FitOptions) -> Fit2DOptions {
         stretch: [stretch(k0), stretch(k1)],
         fd_step: 1e-3,
         strict_patches: opts.strict_patches,
+        compression_residual: opts.compression_residual,
     }
 }
 
@@ -562,6 +582,7 @@ fn term_reports(
             twist_rounds: f.report.twist_rounds,
             slope_rounds: f.report.slope_rounds,
             nonmonotone_patches: f.report.nonmonotone_patches,
+            compression_nonmonotone: f.report.compression_nonmonotone,
             model: model_error(material, by_index.in_range(plan.range_2d(p))),
         })
         .collect();
@@ -614,6 +635,15 @@ fn meta_block(
             "strict_patches": opts.strict_patches,
         }),
     );
+    // the options of issue 19 appear only when set, so a default fit's meta block stays as it was
+    if let Some(serde_json::Value::Object(o)) = meta.get_mut("fit options") {
+        if opts.compression_residual {
+            o.insert("compression_residual".into(), serde_json::json!(true));
+        }
+        if !opts.symmetric_shear {
+            o.insert("symmetric_shear".into(), serde_json::json!(false));
+        }
+    }
     meta.insert(
         "fit errors".into(),
         serde_json::json!({

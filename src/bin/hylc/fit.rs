@@ -64,6 +64,14 @@ pub struct Args {
     /// the cross slopes)
     #[arg(long)]
     twist_only: bool,
+    /// keep FIT2D's residual on the compressed half-plane of s_x or s_y as a non-negative excess, monotone
+    /// outward from the axes (FIT2D step 7′), instead of zeroing it
+    #[arg(long)]
+    compression_residual: bool,
+    /// fit the two signs of shear s_a separately instead of symmetrising every term in s_a (for patterns whose
+    /// Ψ̄ is not even in s_a, e.g. the knits)
+    #[arg(long)]
+    asymmetric_shear: bool,
 }
 
 /// Where the 1D knot slopes come from (`hylc::fit::SlopeSource`).
@@ -101,6 +109,8 @@ impl Args {
         options.slopes = self.slopes.into();
         options.thin_1d = self.thin_1d.max(1);
         options.strict_patches = !self.twist_only;
+        options.compression_residual = self.compression_residual;
+        options.symmetric_shear = !self.asymmetric_shear;
         options
     }
 }

@@ -80,6 +80,9 @@ pub struct Fit2DOptions {
     /// after the twists, also shrink the cross slopes of failing patches until every patch is monotone (default
     /// true); false stops after the twists and only counts the failing patches
     pub strict_patches: bool,
+    /// step 7′ instead of step 7 ([`compression`]): the residual on the compressed half-plane of a stretch axis
+    /// kept as a non-negative excess, monotone outward from the axes (default false: zeroed)
+    pub compression_residual: bool,
 }
 
 impl Default for Fit2DOptions {
@@ -96,6 +99,7 @@ impl Default for Fit2DOptions {
             stretch: [false, false],
             fd_step: 1e-3,
             strict_patches: true,
+            compression_residual: false,
         }
     }
 }
@@ -119,6 +123,8 @@ pub struct Fit2DReport {
     pub slope_rounds: usize,
     /// patches still failing the monotonicity check of step 5
     pub nonmonotone_patches: usize,
+    /// patches of the compressed block still failing step 7′'s check (0 without it)
+    pub compression_nonmonotone: usize,
 }
 
 /// A fitted 2D term: the residual spline the material uses, the unconverted spline f, and the report.
@@ -196,6 +202,7 @@ struct Failing {
 }
 
 /// Grid data of a bicubic Hermite spline with u inner: index j·nu + i.
+#[derive(Clone)]
 struct Grid {
     tu: Vec<f64>,
     tv: Vec<f64>,
@@ -284,19 +291,8 @@ impl Grid {
                 if !(check_x || check_y) {
                     continue;
                 }
-                let net = self.bezier_net((ci, cj));
-                // Bernstein coefficients of the outward derivative, first index along the derivative
-                // (degree 2), second across it (degree 3)
-                let mut du = [[0.0; 4]; 3];
-                let mut dv = [[0.0; 4]; 3];
-                for a in 0..3 {
-                    for b in 0..4 {
-                        du[a][b] = sx * 3.0 * (net[a + 1][b] - net[a][b]);
-                        dv[a][b] = sy * 3.0 * (net[b][a + 1] - net[b][a]);
-                    }
-                }
-                let fx = check_x && !nonnegative(&du, tol);
-                let fy = check_y && !nonnegative(&dv, tol);
+                let (fx, fy) =
+                    self.patch_fails((ci, cj), check_x.then_some(sx), check_y.then_some(sy), tol);
                 if fx || fy {
                     out.push(Failing {
                         cell: (ci, cj),
@@ -307,6 +303,31 @@ impl Grid {
             }
         }
         out
+    }
+
+    /// Whether patch `(ci, cj)` fails the outward monotonicity certificate along u (sign `su`) and along v (sign
+    /// `sv`), `None` for a direction not checked; the Bernstein coefficients of
+    /// the outward derivative have their first index along the derivative (degree 2), the second across (degree 3).
+    fn patch_fails(
+        &self,
+        cell: (usize, usize),
+        su: Option<f64>,
+        sv: Option<f64>,
+        tol: f64,
+    ) -> (bool, bool) {
+        let net = self.bezier_net(cell);
+        let mut du = [[0.0; 4]; 3];
+        let mut dv = [[0.0; 4]; 3];
+        for a in 0..3 {
+            for b in 0..4 {
+                du[a][b] = su.unwrap_or(0.0) * 3.0 * (net[a + 1][b] - net[a][b]);
+                dv[a][b] = sv.unwrap_or(0.0) * 3.0 * (net[b][a + 1] - net[b][a]);
+            }
+        }
+        (
+            su.is_some() && !nonnegative(&du, tol),
+            sv.is_some() && !nonnegative(&dv, tol),
+        )
     }
 }
 
@@ -781,9 +802,14 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
 
     // step 6
     let mut r = grid.residual(min.i, min.j0);
-    // step 7
+    // step 7 (or 7′)
+    let mut compression = PatchRounds::default();
     if opts.quasi_convex {
-        r.zero_compression(opts.stretch);
+        if opts.compression_residual {
+            compression = r.compression_excess(opts.stretch, min.i, min.j0);
+        } else {
+            r.zero_compression(opts.stretch);
+        }
     }
     // step 8
     r.bound_extrapolation();
@@ -798,6 +824,7 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
         twist_rounds: rounds.twist,
         slope_rounds: rounds.slope,
         nonmonotone_patches: rounds.nonmonotone,
+        compression_nonmonotone: compression.nonmonotone,
     };
     Ok(Fit2D {
         residual: r.spline(),
@@ -806,5 +833,6 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
     })
 }
 
+mod compression;
 #[cfg(test)]
 mod tests;
