@@ -62,13 +62,7 @@ impl FoldBarrier {
                 format!("must lie strictly between 0 and π rad, got {}", self.angle),
             ));
         }
-        if !(self.stiffness > 0.0 && self.stiffness.is_finite()) {
-            return Err((
-                "stiffness",
-                format!("must be a positive number (J/m²), got {}", self.stiffness),
-            ));
-        }
-        Ok(())
+        check_stiffness(self.stiffness)
     }
 
     /// (β, dβ/dθ, d²β/dθ²) at the hinge angle θ; `None` when |θ| ≥ π (folded flat: infinite energy).
@@ -89,6 +83,17 @@ impl FoldBarrier {
     pub fn weight(&self, area: f64) -> f64 {
         self.stiffness * area / 3.0
     }
+}
+
+/// Both barriers' energy density scale must be a positive number.
+fn check_stiffness(stiffness: f64) -> Result<(), (&'static str, String)> {
+    if !(stiffness > 0.0 && stiffness.is_finite()) {
+        return Err((
+            "stiffness",
+            format!("must be a positive number (J/m²), got {stiffness}"),
+        ));
+    }
+    Ok(())
 }
 
 /// The clamped log barrier b(d; d̂) = −(d − d̂)² ln(d/d̂) for 0 < d < d̂, 0 for d ≥ d̂, and its first two
@@ -148,13 +153,7 @@ impl CollapseBarrier {
                 format!("must lie strictly between 0 and 1, got {}", self.area),
             ));
         }
-        if !(self.stiffness > 0.0 && self.stiffness.is_finite()) {
-            return Err((
-                "stiffness",
-                format!("must be a positive number (J/m²), got {}", self.stiffness),
-            ));
-        }
-        Ok(())
+        check_stiffness(self.stiffness)
     }
 
     /// The energy density k_c β_J(J(z)) and its gradient and Hessian in z (only the in-plane block is non-zero)
