@@ -187,6 +187,18 @@ impl ElementModel {
         let Some(fold) = &self.fold else {
             return Some(0.0);
         };
+        let mut active = [None; 3];
+        for (i, a) in active.iter_mut().enumerate() {
+            if let Some(theta) = ch.hinge_angle(i) {
+                let p = fold.profile(theta)?;
+                if p[1] != 0.0 || p[2] != 0.0 {
+                    *a = Some(p);
+                }
+            }
+        }
+        if active.iter().all(Option::is_none) {
+            return Some(0.0);
+        }
         let c = fold.weight(area);
         let mut e = 0.0;
         let mut scratch = [[0.0; NDOF]; NDOF];
@@ -194,16 +206,11 @@ impl ElementModel {
             Some((h, curv)) => (h, curv),
             None => (&mut scratch, false),
         };
-        for i in 0..3 {
-            let Some(theta) = ch.hinge_angle(i) else {
-                continue;
-            };
-            let [b, b1, b2] = fold.profile(theta)?;
-            if b1 == 0.0 && b2 == 0.0 {
-                continue;
+        for (i, a) in active.iter().enumerate() {
+            if let Some([b, b1, b2]) = *a {
+                e += c * b;
+                ch.add_hinge_angle_terms(i, c * b1, c * b2, curvature, grad, h);
             }
-            e += c * b;
-            ch.add_hinge_angle_terms(i, c * b1, c * b2, curvature, grad, h);
         }
         Some(e)
     }
@@ -395,8 +402,22 @@ impl ElementModel {
 }
 
 /// Clamp the eigenvalues of a symmetric 6×6 matrix at 0.
+/// A Cholesky attempt on the rows that are not identically zero first: when it succeeds the matrix is positive
+/// semi-definite and stays as it is, without the eigen-decomposition.
 fn project6(h: &mut [[f64; 6]; 6]) {
-    let m = SMatrix::<f64, 6, 6>::from_fn(|i, j| 0.5 * (h[i][j] + h[j][i]));
+    let sym = |i: usize, j: usize| 0.5 * (h[i][j] + h[j][i]);
+    let mut live = [0; 6];
+    let mut n = 0;
+    for i in 0..6 {
+        if (0..6).any(|j| h[i][j] != 0.0 || h[j][i] != 0.0) {
+            live[n] = i;
+            n += 1;
+        }
+    }
+    if cholesky_succeeds::<6>(sym, &live[..n], 0.0) {
+        return;
+    }
+    let m = SMatrix::<f64, 6, 6>::from_fn(sym);
     let eig = SymmetricEigen::new(m);
     if eig.eigenvalues.iter().all(|&l| l >= 0.0) {
         return;
@@ -422,7 +443,7 @@ pub fn project18(h: &mut [[f64; NDOF]; NDOF]) {
     let live: Vec<usize> = (0..NDOF)
         .filter(|&i| (0..NDOF).any(|j| m[(i, j)] != 0.0))
         .collect();
-    if cholesky_above_minus_floor(&m, &live) {
+    if cholesky_succeeds::<NDOF>(|i, j| m[(i, j)], &live, EIGEN_FLOOR) {
         return;
     }
     for i in 0..NDOF {
@@ -446,14 +467,18 @@ pub fn project18(h: &mut [[f64; NDOF]; NDOF]) {
     }
 }
 
-/// True when the principal submatrix on `live` plus floor·I has a Cholesky factorisation (all eigenvalues of
-/// that block above −floor).
-fn cholesky_above_minus_floor(m: &SMatrix<f64, NDOF, NDOF>, live: &[usize]) -> bool {
+/// Whether the Cholesky factorisation of m + shift·I restricted to the rows and columns `live` succeeds (every
+/// pivot positive): then every eigenvalue of m on those rows is above −shift.
+fn cholesky_succeeds<const N: usize>(
+    m: impl Fn(usize, usize) -> f64,
+    live: &[usize],
+    shift: f64,
+) -> bool {
     let n = live.len();
-    let mut l = [[0.0; NDOF]; NDOF];
+    let mut l = [[0.0; N]; N];
     for a in 0..n {
         for b in 0..=a {
-            let mut s = m[(live[a], live[b])] + if a == b { EIGEN_FLOOR } else { 0.0 };
+            let mut s = m(live[a], live[b]) + if a == b { shift } else { 0.0 };
             for k in 0..b {
                 s -= l[a][k] * l[b][k];
             }

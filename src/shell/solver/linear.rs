@@ -73,11 +73,18 @@ impl Simulation {
         let req = sym
             .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
             .or(sym.solve_in_place_scratch::<f64>(1, Par::Seq));
-        let mut buf = MemBuffer::new(req);
+        let mut guard = self
+            .factor_scratch
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        let (factor, buf) = &mut *guard;
+        if buf.len() < req.size_bytes() {
+            *buf = MemBuffer::new(req);
+        }
+        factor.resize(sym.len_val(), 0.0);
         let mat = SparseColMatRef::new(self.pattern.lower.symbolic(), values);
-        let mut factor = vec![0.0; sym.len_val()];
         sym.factorize_numeric_llt(
-            &mut factor,
+            factor,
             mat,
             Side::Lower,
             LltRegularization {
@@ -85,17 +92,17 @@ impl Simulation {
                 dynamic_regularization_epsilon: 0.0,
             },
             Par::Seq,
-            MemStack::new(&mut buf),
+            MemStack::new(buf),
             Default::default(),
         )
         .ok()?;
-        let llt = LltRef::new(sym, &factor);
+        let llt = LltRef::new(sym, factor);
         let mut d: Vec<f64> = g.iter().map(|x| -x).collect();
         llt.solve_in_place_with_conj(
             Conj::No,
             faer::MatMut::from_column_major_slice_mut(&mut d, nf, 1),
             Par::Seq,
-            MemStack::new(&mut buf),
+            MemStack::new(buf),
         );
         d.iter().all(|x| x.is_finite()).then_some(d)
     }

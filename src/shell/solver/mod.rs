@@ -243,6 +243,8 @@ pub struct Simulation {
     pub stencils: Vec<Stencil>,
     pub pattern: Pattern,
     symbolic: SymbolicCholesky<usize>,
+    /// the Cholesky factor's values and faer's workspace, kept from one factorisation to the next
+    factor_scratch: std::sync::Mutex<(Vec<f64>, faer::dyn_stack::MemBuffer)>,
     pub x0: Vec<f64>,
     pub x: Vec<f64>,
     pub v: Vec<f64>,
@@ -364,6 +366,10 @@ impl Simulation {
             stencils,
             pattern,
             symbolic,
+            factor_scratch: std::sync::Mutex::new((
+                vec![],
+                faer::dyn_stack::MemBuffer::new(Default::default()),
+            )),
             x0: x.clone(),
             v: vec![0.0; x.len()],
             x,
