@@ -82,6 +82,21 @@ impl Default for FitOptions {
 }
 
 impl FitOptions {
+    /// Settings whose spline knots cover everything sampled, for plans with few 2D samples per axis (the quick
+    /// plan of `hylc run`: 6): the knots of every 2D term span the whole sampled range (extent 1, 11 knots per
+    /// axis, so no sample lies beyond the knot box, where step 8 holds the residual constant), and the compressed
+    /// half-plane keeps its residual (FIT2D step 7′). Measurements in the README ("Set-up").
+    pub fn covering() -> Self {
+        FitOptions {
+            n_knots_2d: 11,
+            extent_2d: 1.0,
+            n_knots_2d_bending: 11,
+            extent_2d_bending: 1.0,
+            compression_residual: true,
+            ..FitOptions::default()
+        }
+    }
+
     /// The design's settings for stockinette-like patterns: pˣ_min = 0.01, and the pairs with a bending strain
     /// with 5 knots per axis on 0.3 of the range (the layout of the original stock1 material; its in-plane pairs
     /// keep 0.9).

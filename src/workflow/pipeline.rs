@@ -11,7 +11,7 @@ use super::inputs::{construction_of, load_pattern, load_plan};
 use super::sidecar::write_meta;
 use super::simulate::{execute, prepare_noted, snapshot, summary_line, Outcome, Overrides};
 use super::{write_file, Event, WorkflowError};
-use crate::fit::model::FitReport;
+use crate::fit::model::{FitOptions, FitReport};
 use crate::micro::reference::{reference_state, Construction, ReferenceOptions};
 use crate::micro::{MicroProblem, SolverOptions};
 use crate::pattern::Pattern;
@@ -47,6 +47,8 @@ pub struct RunConfig {
     pub construction: Option<Construction>,
     /// The yarn parameters of every solve (reference state, sampling, held-out grid); `hylc run --yarn FILE`.
     pub yarn: YarnMaterial,
+    /// The fit's settings ([`FitOptions::covering`] by default).
+    pub fit: FitOptions,
 }
 
 impl Default for RunConfig {
@@ -64,6 +66,7 @@ impl Default for RunConfig {
             fresh: false,
             construction: None,
             yarn: YarnMaterial::default(),
+            fit: FitOptions::covering(),
         }
     }
 }
@@ -262,6 +265,7 @@ fn run_pattern(args: &RunConfig, arg: &str, log: &mut Log) -> Result<PatternRun,
         report: dir.join("fit.json"),
         plots: dir.join("plots"),
         holdout: vec![dir.join("holdout.jsonl")],
+        options: args.fit.clone(),
         ..FitJob::beside(&dir.join("samples.jsonl"))
     };
     let report: FitReport = fit_samples(&job, &mut |e| log.event(e))?;

@@ -72,6 +72,16 @@ pub struct Args {
     /// Ψ̄ is not even in s_a, e.g. the knits)
     #[arg(long)]
     asymmetric_shear: bool,
+    /// knots per axis of the 2D terms with a bending strain (default 9, or 5 with --stockinette-like)
+    #[arg(long)]
+    knots_2d_bending: Option<usize>,
+    /// extent of the knots of the 2D terms with a bending strain as a fraction of the data range (default 0.9,
+    /// or 0.3 with --stockinette-like)
+    #[arg(long)]
+    extent_bending: Option<f64>,
+    /// MLS bandwidth of every term (1D and 2D) in median sample spacings
+    #[arg(long, default_value_t = 2.0)]
+    bandwidth: f64,
 }
 
 /// Where the 1D knot slopes come from (`hylc::fit::SlopeSource`).
@@ -111,6 +121,13 @@ impl Args {
         options.strict_patches = !self.twist_only;
         options.compression_residual = self.compression_residual;
         options.symmetric_shear = !self.asymmetric_shear;
+        if let Some(k) = self.knots_2d_bending {
+            options.n_knots_2d_bending = k;
+        }
+        if let Some(e) = self.extent_bending {
+            options.extent_2d_bending = e;
+        }
+        options.bandwidth_factor = self.bandwidth;
         options
     }
 }

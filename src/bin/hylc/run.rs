@@ -3,6 +3,7 @@
 
 use crate::args::{ConstructionArg, YarnArgs};
 use crate::printer::Printer;
+use hylc::fit::FitOptions;
 use hylc::workflow::pipeline::{self, RunConfig};
 use hylc::workflow::simulate::diverged;
 use std::path::PathBuf;
@@ -43,6 +44,10 @@ pub struct Args {
     /// delete the output folder first instead of resuming
     #[arg(long)]
     fresh: bool,
+    /// fit with the design's settings (those of `hylc fit` without options) instead of knots covering every
+    /// sample with the compressed half-plane's residual kept (the default here)
+    #[arg(long)]
+    design_fit: bool,
     #[command(flatten)]
     yarn: YarnArgs,
 }
@@ -59,6 +64,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         fresh: a.fresh,
         construction: a.construction.map(Into::into),
         yarn: a.yarn.material()?,
+        fit: if a.design_fit {
+            FitOptions::default()
+        } else {
+            FitOptions::covering()
+        },
     };
     let mut printer = Printer::default();
     match pipeline::run(&config, &mut |e| printer.show(e)) {
