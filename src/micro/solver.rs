@@ -72,7 +72,7 @@ pub struct SolverOptions {
     /// Per-stencil projection of the local Hessians to positive semi-definite (`03-homogenization.md`, section 3,
     /// the alternative to the μ shift; [`crate::tile::psd`]): always, or only where the exact H + μI does not
     /// factorise at μ's floor. Off (the default): the exact Hessian with the μ shift; on the original rib,
-    /// honeycomb and basket both variants took 10–30× the CPU time, the projected steps converging linearly (README,
+    /// honeycomb and basket both variants took 9–31× the CPU time, the projected steps converging linearly (README,
     /// "Micro-solver speed (issue 20)"). Not written to the settings JSON while off.
     #[serde(skip_serializing_if = "PsdStencils::is_off")]
     pub psd_stencils: PsdStencils,
