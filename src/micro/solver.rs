@@ -69,6 +69,13 @@ pub struct SolverOptions {
     /// rule. Not written to the settings JSON while off.
     #[serde(skip_serializing_if = "is_false")]
     pub keep_shift: bool,
+    /// Per-stencil projection of the local Hessians to positive semi-definite (`03-homogenization.md`, section 3,
+    /// the alternative to the μ shift; [`crate::tile::psd`]): always, or only where the exact H + μI does not
+    /// factorise at μ's floor. Off (the default): the exact Hessian with the μ shift; on the original rib,
+    /// honeycomb and basket both variants took 9–31× the CPU time, the projected steps converging linearly (README,
+    /// "Micro-solver speed (issue 20)"). Not written to the settings JSON while off.
+    #[serde(skip_serializing_if = "PsdStencils::is_off")]
+    pub psd_stencils: PsdStencils,
     /// Emit one `tracing` event (info level) per Newton step: energy, ‖g‖∞, decrement, μ, step length (`hylc
     /// solve --trace` prints them to stderr).
     pub trace: bool,
@@ -87,8 +94,31 @@ impl Default for SolverOptions {
             contact_margin: crate::tile::contact::DEFAULT_MARGIN,
             projected_steps: false,
             keep_shift: false,
+            psd_stencils: PsdStencils::Off,
             trace: false,
         }
+    }
+}
+
+/// When the Newton matrix is built from per-stencil positive semi-definite projections of the local Hessians
+/// ([`SolverOptions::psd_stencils`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PsdStencils {
+    /// Never: the exact Hessian, μ grown ×10 until H + μI factorises (the design's default).
+    #[default]
+    Off,
+    /// At every Newton step: H is positive semi-definite by construction and μ stays at its floor.
+    Always,
+    /// Only at the steps where the exact H + μI does not factorise (or gives no descent direction) at μ's floor:
+    /// the projected H is tried at the floor before μ grows.
+    Fallback,
+}
+
+impl PsdStencils {
+    /// serde's `skip_serializing_if`.
+    fn is_off(&self) -> bool {
+        *self == PsdStencils::Off
     }
 }
 
@@ -503,7 +533,11 @@ impl MicroProblem {
                 return Ok(run.finish(state, status, &ev, gnorm));
             }
             // 3. KKT step
-            let Some(mut delta) = run.direction(&ev, &g)? else {
+            let direction = match opts.psd_stencils {
+                PsdStencils::Fallback => run.fallback_direction(&ev, &g, &state)?,
+                PsdStencils::Off | PsdStencils::Always => run.direction(&ev, &g)?,
+            };
+            let Some(mut delta) = direction else {
                 return Ok(run.finish(state, Status::Stalled, &ev, gnorm));
             };
             let decrement: f64 = g.iter().zip(&delta).map(|(a, b)| a * b).sum();
@@ -517,7 +551,7 @@ impl MicroProblem {
             if opts.trace {
                 tracing::info!(
                     "step {}: E {energy:.15e} J, |g|inf {gnorm:.3e} N, g.d {decrement:.3e} J, mu {:.2e}, \
-                     |d|max {:.3e} m, accepted {}, symbolic analyses {}, projected steps {}",
+                     |d|max {:.3e} m, accepted {}, symbolic analyses {}, projected steps {}, psd fallbacks {}",
                     run.steps,
                     run.mu,
                     dmax_now.min(run.d_max),
@@ -526,7 +560,8 @@ impl MicroProblem {
                         None => "none".into(),
                     },
                     run.kkt.analyses,
-                    run.projected
+                    run.projected,
+                    run.fallbacks
                 );
             }
             run.steps += 1;
@@ -567,6 +602,8 @@ struct NewtonRun<'p> {
     projected: usize,
     /// Whether μ had to grow in the current step.
     grew: bool,
+    /// Steps that fell back to the projected Hessian ([`PsdStencils::Fallback`]).
+    fallbacks: usize,
     n: usize,
     /// Yarn radius r, stretch stiffness k_s, broad-phase margin, displacement limit d_max, tile area p₁ p₂.
     r: f64,
@@ -588,6 +625,7 @@ impl<'p> NewtonRun<'p> {
         let r = problem.pattern.radius;
         let elim = Elimination::in_family(&problem.pattern, &state.strain, state.family);
         let mut tile = problem.tile(&elim);
+        tile.psd_stencils = opts.psd_stencils == PsdStencils::Always;
         let margin = opts.contact_margin * r;
         let mut timings = Timings::default();
 
@@ -612,6 +650,7 @@ impl<'p> NewtonRun<'p> {
             steps: 0,
             projected: 0,
             grew: false,
+            fallbacks: 0,
             n: problem.pattern.len(),
             r,
             ks: problem.material.stretch_stiffness(),
@@ -663,6 +702,43 @@ impl<'p> NewtonRun<'p> {
     /// direction; `None` when 40 attempts fail.
     fn direction(&mut self, ev: &TileEval, g: &[f64]) -> Result<Option<Vec<f64>>, MicroError> {
         let tf = Instant::now();
+        self.set_newton_matrix(ev)?;
+        self.grew = false;
+        let mut delta = None;
+        for _ in 0..40 {
+            if let Some(d) = self.try_step(g)? {
+                delta = Some(d);
+                break;
+            }
+            self.mu *= 10.0;
+            self.grew = true;
+        }
+        // A shift above the floor means H is not positive definite in the full space; it may still be on the
+        // constraint space (e.g. a slide constraint holding back a yarn that would slide), where the exact
+        // Newton step exists: projected conjugate gradients with the factorisation just made as the
+        // preconditioner. Where they meet negative curvature, the shifted step stays.
+        if delta.is_some() && self.mu > self.mu_floor && self.problem.options.projected_steps {
+            let exact = self.kkt.solve_projected_kept(
+                g,
+                &self.problem.constraints,
+                PROJECTED_TOLERANCE,
+                PROJECTED_MAX_ITERATIONS,
+            );
+            if let Ok(d) = exact {
+                if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
+                    delta = Some(d);
+                    self.projected += 1;
+                }
+            }
+        }
+        self.timings.factorization += tf.elapsed().as_secs_f64();
+        self.max_mu = self.max_mu.max(self.mu);
+        Ok(delta)
+    }
+
+    /// Store the scaled Hessian of `ev` in the KKT solver (with the rod structure at the first step) and set μ's
+    /// floor from its largest diagonal entry; μ is raised to the floor.
+    fn set_newton_matrix(&mut self, ev: &TileEval) -> Result<(), MicroError> {
         let mut lower: Vec<(usize, usize, f64)> = ev
             .hessian
             .as_ref()
@@ -686,52 +762,58 @@ impl<'p> NewtonRun<'p> {
         // step that is not a descent direction counts as a failed factorisation.
         self.mu_floor = 1e-10 * diag_max;
         self.mu = self.mu.max(self.mu_floor);
-        let mut delta = None;
-        self.grew = false;
         self.kkt
             .set_matrix(4 * self.n, &lower)
-            .map_err(MicroError::Linear)?;
+            .map_err(MicroError::Linear)
+    }
+
+    /// The KKT step at the current μ for the stored matrix: `None` when H + μI does not factorise or the step is
+    /// not a descent direction.
+    fn try_step(&mut self, g: &[f64]) -> Result<Option<Vec<f64>>, MicroError> {
+        // at the floor, two refinement steps remove the shift's effect on soft modes (exact Newton)
+        let refine = if self.mu <= self.mu_floor { 2 } else { 0 };
         let rhs = [g.to_vec()];
-        for _ in 0..40 {
-            // at the floor, two refinement steps remove the shift's effect on soft modes (exact Newton)
-            let refine = if self.mu <= self.mu_floor { 2 } else { 0 };
-            let solved = self
-                .kkt
-                .solve_shifted(self.mu, &rhs, &self.problem.constraints, refine)
-                .map(|mut v| v.pop().expect("one right-hand side"));
-            match solved {
-                Ok(d) if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 => {
-                    delta = Some(d);
-                    break;
-                }
-                Ok(_) | Err(FactorError::NotPositiveDefinite) => {
-                    self.mu *= 10.0;
-                    self.grew = true;
-                }
-                Err(e) => return Err(MicroError::Linear(e)),
-            }
+        let solved = self
+            .kkt
+            .solve_shifted(self.mu, &rhs, &self.problem.constraints, refine)
+            .map(|mut v| v.pop().expect("one right-hand side"));
+        match solved {
+            Ok(d) if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 => Ok(Some(d)),
+            Ok(_) | Err(FactorError::NotPositiveDefinite) => Ok(None),
+            Err(e) => Err(MicroError::Linear(e)),
         }
-        // A shift above the floor means H is not positive definite in the full space; it may still be on the
-        // constraint space (e.g. a slide constraint holding back a yarn that would slide), where the exact
-        // Newton step exists: projected conjugate gradients with the factorisation just made as the
-        // preconditioner. Where they meet negative curvature, the shifted step stays.
-        if delta.is_some() && self.mu > self.mu_floor && self.problem.options.projected_steps {
-            let exact = self.kkt.solve_projected_kept(
-                g,
-                &self.problem.constraints,
-                PROJECTED_TOLERANCE,
-                PROJECTED_MAX_ITERATIONS,
-            );
-            if let Ok(d) = exact {
-                if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
-                    delta = Some(d);
-                    self.projected += 1;
-                }
-            }
-        }
+    }
+
+    /// [`PsdStencils::Fallback`]: the exact KKT step at μ's floor when H + μ_floor I factorises and gives a descent
+    /// direction; else the step of [`NewtonRun::direction`] on the Hessian with every stencil projected to
+    /// positive semi-definite (evaluated again at `state`), which grows μ only when that one fails too.
+    fn fallback_direction(
+        &mut self,
+        ev: &TileEval,
+        g: &[f64],
+        state: &MicroState,
+    ) -> Result<Option<Vec<f64>>, MicroError> {
+        let tf = Instant::now();
+        self.set_newton_matrix(ev)?;
+        self.grew = false;
+        let saved = self.mu;
+        self.mu = self.mu_floor;
+        let exact = self.try_step(g)?;
         self.timings.factorization += tf.elapsed().as_secs_f64();
-        self.max_mu = self.max_mu.max(self.mu);
-        Ok(delta)
+        if let Some(d) = exact {
+            self.max_mu = self.max_mu.max(self.mu);
+            return Ok(Some(d));
+        }
+        self.mu = saved;
+        let ta = Instant::now();
+        self.tile.psd_stencils = true;
+        let projected = self
+            .tile
+            .evaluate(&state.frames, &state.y, Want::Hessian, &Terms::ALL);
+        self.tile.psd_stencils = false;
+        self.timings.assembly += ta.elapsed().as_secs_f64();
+        self.fallbacks += 1;
+        self.direction(&projected?, g)
     }
 
     /// Back to tile dofs (θ = y_θ / r), then the displacement limit: scale the step so that no vertex moves by

@@ -66,7 +66,8 @@ pub(super) fn assemble(
                     h: Default::default(),
                 }))
             } else {
-                let r = kernel.value_gradient_hessian(&x, la, lb)?;
+                let mut r = kernel.value_gradient_hessian(&x, la, lb)?;
+                tile.project_local(want, &mut r.hessian);
                 Ok(Some(super::Local {
                     value: r.value,
                     g: r.gradient,

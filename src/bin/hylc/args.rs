@@ -2,7 +2,7 @@
 
 use clap::ValueEnum;
 use hylc::micro::reference::Construction;
-use hylc::micro::SolverOptions;
+use hylc::micro::{PsdStencils, SolverOptions};
 use hylc::rod::YarnMaterial;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -26,6 +26,28 @@ pub struct SolverArgs {
     /// after a step whose factorisation needed a larger shift μ, start the next step at that μ (not μ/10)
     #[arg(long)]
     pub keep_shift: bool,
+    /// project each rod stencil's and contact pair's local Hessian to positive semi-definite: always, or only
+    /// where the exact H + μI does not factorise at μ's floor (fallback); off: the exact Hessian with the μ shift
+    #[arg(long, value_enum, default_value = "off")]
+    pub psd_stencils: PsdStencilsArg,
+}
+
+/// `--psd-stencils` ([`PsdStencils`]).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PsdStencilsArg {
+    Off,
+    Always,
+    Fallback,
+}
+
+impl From<PsdStencilsArg> for PsdStencils {
+    fn from(p: PsdStencilsArg) -> Self {
+        match p {
+            PsdStencilsArg::Off => PsdStencils::Off,
+            PsdStencilsArg::Always => PsdStencils::Always,
+            PsdStencilsArg::Fallback => PsdStencils::Fallback,
+        }
+    }
 }
 
 impl SolverArgs {
@@ -37,6 +59,7 @@ impl SolverArgs {
             time_limit: self.time_limit,
             projected_steps: self.projected_steps,
             keep_shift: self.keep_shift,
+            psd_stencils: self.psd_stencils.into(),
             ..Default::default()
         }
     }
