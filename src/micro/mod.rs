@@ -8,6 +8,7 @@
 pub mod elimination;
 pub mod envelope;
 pub mod linear;
+pub mod options;
 pub mod predict;
 pub mod reference;
 pub mod sensitivity;

@@ -16,6 +16,7 @@
 
 use super::elimination::Elimination;
 use super::linear::{FactorError, KktSolver};
+pub use super::options::{PsdStencils, SolverOptions};
 use super::strain::{Family, MacroStrain, StrainError};
 use crate::contact::ContactError;
 use crate::pattern::Pattern;
@@ -31,101 +32,6 @@ use std::time::Instant;
 const PROJECTED_TOLERANCE: f64 = 1e-10;
 /// Iteration limit of those conjugate gradients (beyond it the shifted step is taken).
 const PROJECTED_MAX_ITERATIONS: usize = 100;
-
-/// Solver settings (`03-homogenization.md`, section 4; defaults from there).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct SolverOptions {
-    /// Dimensionless force tolerance: converged when ‖g‖_∞ ≤ tolerance · k_s.
-    pub tolerance: f64,
-    /// Newton-decrement test: converged when |gᵀδy| ≤ decrement_tolerance · (|E| + k_s r) (design default
-    /// 1e-14). For a small tile this is looser than the force test (|E| ≪ k_s r), so derivative checks against
-    /// re-solves set it to 0 and rely on the force test alone.
-    pub decrement_tolerance: f64,
-    /// Newton step limit.
-    pub max_steps: usize,
-    /// Wall-time limit per solve (seconds), none by default.
-    pub time_limit: Option<f64>,
-    /// Displacement limit factor: d_max = step_factor · r · λ_min(Ī).
-    pub step_factor: f64,
-    /// Constrain each yarn's slide along itself (the original allowed switching it off).
-    pub slide_constraints: bool,
-    /// Backtracking factor of the line search: trial steps factorⁱ down to 1e-10 (the design's 0.1ⁱ, i ≤ 10,
-    /// is `0.1`).
-    pub backtracking: f64,
-    /// Broad-phase margin in units of r.
-    pub contact_margin: f64,
-    /// Where H + μI factorises only with μ above its floor (H indefinite in the full space), take the exact
-    /// Newton step on the constraint space when H is positive definite there (projected conjugate gradients
-    /// preconditioned by that factorisation), else the shifted step. Off: always the shifted step (the design's
-    /// plain μ regularisation, the default: on the original rib the exact steps reach other, lower equilibria
-    /// than the shifted ones and take more steps; README-micro.md). Not written to the settings JSON while off,
-    /// so the problem hash of existing sample files stays.
-    #[serde(skip_serializing_if = "is_false")]
-    pub projected_steps: bool,
-    /// After a step whose factorisation failed at its first shift (μ had to grow), start the next step at the
-    /// μ that worked instead of μ/10: in a region where H is indefinite, each step then saves the
-    /// factorisation that would fail again. Off (the default): μ/10 after every accepted step, the design's
-    /// rule. Not written to the settings JSON while off.
-    #[serde(skip_serializing_if = "is_false")]
-    pub keep_shift: bool,
-    /// Per-stencil projection of the local Hessians to positive semi-definite (`03-homogenization.md`, section 3,
-    /// the alternative to the μ shift; [`crate::tile::psd`]): always, or only where the exact H + μI does not
-    /// factorise at μ's floor. Off (the default): the exact Hessian with the μ shift; on the original rib,
-    /// honeycomb and basket both variants took 9–31× the CPU time, the projected steps converging linearly (README,
-    /// "Micro-solver speed (issue 20)"). Not written to the settings JSON while off.
-    #[serde(skip_serializing_if = "PsdStencils::is_off")]
-    pub psd_stencils: PsdStencils,
-    /// Emit one `tracing` event (info level) per Newton step: energy, ‖g‖∞, decrement, μ, step length (`hylc
-    /// solve --trace` prints them to stderr).
-    pub trace: bool,
-}
-
-impl Default for SolverOptions {
-    fn default() -> Self {
-        SolverOptions {
-            tolerance: 1e-8,
-            decrement_tolerance: 1e-14,
-            max_steps: 2000,
-            time_limit: None,
-            step_factor: 1.0,
-            slide_constraints: true,
-            backtracking: 0.1,
-            contact_margin: crate::tile::contact::DEFAULT_MARGIN,
-            projected_steps: false,
-            keep_shift: false,
-            psd_stencils: PsdStencils::Off,
-            trace: false,
-        }
-    }
-}
-
-/// When the Newton matrix is built from per-stencil positive semi-definite projections of the local Hessians
-/// ([`SolverOptions::psd_stencils`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum PsdStencils {
-    /// Never: the exact Hessian, μ grown ×10 until H + μI factorises (the design's default).
-    #[default]
-    Off,
-    /// At every Newton step: H is positive semi-definite by construction and μ stays at its floor.
-    Always,
-    /// Only at the steps where the exact H + μI does not factorise (or gives no descent direction) at μ's floor:
-    /// the projected H is tried at the floor before μ grows.
-    Fallback,
-}
-
-impl PsdStencils {
-    /// serde's `skip_serializing_if`.
-    fn is_off(&self) -> bool {
-        *self == PsdStencils::Off
-    }
-}
-
-/// serde's `skip_serializing_if` for options that are off by default.
-fn is_false(v: &bool) -> bool {
-    !*v
-}
 
 /// How a solve ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
