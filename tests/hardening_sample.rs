@@ -49,6 +49,7 @@ fn records(plan: &Plan, truth: &Material) -> Vec<Record> {
                 problem: "0000000000000000".into(),
                 starts: vec![],
                 kept: None,
+                crossings: None,
             }
         })
         .collect()

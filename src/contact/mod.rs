@@ -14,6 +14,7 @@
 //! non-finite number.
 
 pub mod broad;
+pub mod ccd;
 pub mod pair;
 
 pub use broad::{

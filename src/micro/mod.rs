@@ -19,6 +19,7 @@ pub mod surface;
 pub use elimination::Elimination;
 pub use predict::Predictor;
 pub use solver::{
-    MicroError, MicroProblem, MicroState, PsdStencils, Solution, SolverOptions, Status,
+    CrossingGuard, MicroError, MicroProblem, MicroState, PsdStencils, Solution, SolverOptions,
+    Status,
 };
 pub use strain::{Family, MacroStrain, StrainError};

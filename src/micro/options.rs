@@ -47,6 +47,12 @@ pub struct SolverOptions {
     /// "Micro-solver speed (issue 20)"). Not written to the settings JSON while off.
     #[serde(skip_serializing_if = "PsdStencils::is_off")]
     pub psd_stencils: PsdStencils,
+    /// Yarn crossings along the Newton path ([`crate::contact::ccd`]; issue 19, item 1): not checked (the
+    /// default), counted (each accepted step is tested; [`crate::micro::Solution::crossings`]), or rejected (a
+    /// line-search trial whose step passes two yarn centre lines through each other is not accepted, so the solve
+    /// stays in the fabric it started in). Not written to the settings JSON while off.
+    #[serde(skip_serializing_if = "CrossingGuard::is_off")]
+    pub crossings: CrossingGuard,
     /// Emit one `tracing` event (info level) per Newton step: energy, ‖g‖∞, decrement, μ, step length (`hylc
     /// solve --trace` prints them to stderr).
     pub trace: bool,
@@ -66,6 +72,7 @@ impl Default for SolverOptions {
             projected_steps: false,
             keep_shift: false,
             psd_stencils: PsdStencils::Off,
+            crossings: CrossingGuard::Off,
             trace: false,
         }
     }
@@ -90,6 +97,26 @@ impl PsdStencils {
     /// serde's `skip_serializing_if`.
     fn is_off(&self) -> bool {
         *self == PsdStencils::Off
+    }
+}
+
+/// Whether the micro solver checks its steps for yarn crossings ([`SolverOptions::crossings`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum CrossingGuard {
+    /// Not checked.
+    #[default]
+    Off,
+    /// Every accepted step is checked and the crossings are reported; the solve is unchanged.
+    Count,
+    /// A line-search trial that crosses yarns is rejected (the search backtracks further).
+    Reject,
+}
+
+impl CrossingGuard {
+    /// serde's `skip_serializing_if`.
+    fn is_off(&self) -> bool {
+        *self == CrossingGuard::Off
     }
 }
 

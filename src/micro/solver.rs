@@ -16,8 +16,9 @@
 
 use super::elimination::Elimination;
 use super::linear::{FactorError, KktSolver};
-pub use super::options::{PsdStencils, SolverOptions};
+pub use super::options::{CrossingGuard, PsdStencils, SolverOptions};
 use super::strain::{Family, MacroStrain, StrainError};
+use crate::contact::ccd::{net_crossings, Crossing};
 use crate::contact::ContactError;
 use crate::pattern::Pattern;
 use crate::rod::{RodState, RodTopology, YarnMaterial};
@@ -133,6 +134,10 @@ pub struct Solution {
     pub area: f64,
     /// The largest regularisation μ used (N/m).
     pub max_mu: f64,
+    /// Yarn crossings of the accepted steps ([`SolverOptions::crossings`] `count`; empty otherwise).
+    pub crossings: Vec<Crossing>,
+    /// Line-search trials rejected because they crossed yarns ([`SolverOptions::crossings`] `reject`).
+    pub rejected_crossings: usize,
 }
 
 /// Asking for Ψ̄ of a non-converged solve.
@@ -147,6 +152,12 @@ pub struct NotConverged {
 }
 
 impl Solution {
+    /// The pairs whose crossings along the path do not cancel ([`net_crossings`]): 0 for a solve that stayed in
+    /// the fabric it started in (or that did not count).
+    pub fn net_crossings(&self) -> usize {
+        net_crossings(&self.crossings).len()
+    }
+
     /// Ψ̄ = E / (p₁ p₂) (J/m²) of a converged solve; an error for any other status.
     pub fn psi(&self) -> Result<f64, NotConverged> {
         if self.status == Status::Converged {
@@ -409,6 +420,8 @@ impl MicroProblem {
             },
             area: self.pattern.periods[0] * self.pattern.periods[1],
             max_mu: 0.0,
+            crossings: Vec::new(),
+            rejected_crossings: 0,
         }
     }
 
@@ -510,6 +523,9 @@ struct NewtonRun<'p> {
     grew: bool,
     /// Steps that fell back to the projected Hessian ([`PsdStencils::Fallback`]).
     fallbacks: usize,
+    /// Crossings of the accepted steps and trials rejected for crossing ([`SolverOptions::crossings`]).
+    crossings: Vec<Crossing>,
+    rejected_crossings: usize,
     n: usize,
     /// Yarn radius r, stretch stiffness k_s, broad-phase margin, displacement limit d_max, tile area p₁ p₂.
     r: f64,
@@ -557,6 +573,8 @@ impl<'p> NewtonRun<'p> {
             projected: 0,
             grew: false,
             fallbacks: 0,
+            crossings: Vec::new(),
+            rejected_crossings: 0,
             n: problem.pattern.len(),
             r,
             ks: problem.material.stretch_stiffness(),
@@ -774,6 +792,26 @@ impl<'p> NewtonRun<'p> {
                 .map(|r| r.value())
                 .unwrap_or(f64::INFINITY);
             if e < energy {
+                if problem.options.crossings != CrossingGuard::Off {
+                    // a failed check (non-finite positions) counts as a crossing: the trial is not trusted
+                    let crossed = self.tile.crossings(&state.y, &trial).unwrap_or_else(|_| {
+                        vec![Crossing {
+                            a: 0,
+                            b: 0,
+                            offset: [0, 0],
+                            time: f64::NAN,
+                            sign: 0,
+                        }]
+                    });
+                    if !crossed.is_empty() {
+                        if problem.options.crossings == CrossingGuard::Reject {
+                            self.rejected_crossings += 1;
+                            step *= factor;
+                            continue;
+                        }
+                        self.crossings.extend(crossed);
+                    }
+                }
                 let theta = trial[3 * self.n..].to_vec();
                 state.frames.advance(
                     &problem.pattern,
@@ -804,6 +842,8 @@ impl<'p> NewtonRun<'p> {
             timings: self.timings,
             area: self.area,
             max_mu: self.max_mu,
+            crossings: self.crossings.clone(),
+            rejected_crossings: self.rejected_crossings,
         }
     }
 }

@@ -23,7 +23,7 @@ use super::plan::{fnv1a64, Plan, Sample, Step};
 use super::starts::{keep, StartKind, StartResult, Starts};
 use super::SampleError;
 use crate::micro::envelope::strain_derivatives;
-use crate::micro::{MacroStrain, MicroProblem, MicroState, Predictor, Status};
+use crate::micro::{CrossingGuard, MacroStrain, MicroProblem, MicroState, Predictor, Status};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::{HashMap, HashSet};
@@ -71,6 +71,11 @@ pub struct Record {
     /// Which of `starts` the record's `psi`, `stress`, `status` and `steps` are (omitted with one start).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kept: Option<StartKind>,
+    /// Yarn crossings along the kept solve's Newton path that do not cancel (`--crossings count|reject`;
+    /// omitted when not checked): a solve with crossings ended in another fabric and is not kept when another
+    /// start is available.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crossings: Option<usize>,
 }
 
 impl Record {
@@ -502,6 +507,7 @@ impl PlanRun<'_> {
             problem: self.hash.to_string(),
             starts: vec![],
             kept: None,
+            crossings: None,
         };
         match problem.solve(&strain, start) {
             Ok(sol) => {
@@ -514,6 +520,8 @@ impl PlanRun<'_> {
                 record.steps = sol.steps;
                 record.gradient_norm = Some(sol.gradient_norm).filter(|g| g.is_finite());
                 record.time = sol.time + predict_time;
+                record.crossings =
+                    (problem.options.crossings != CrossingGuard::Off).then(|| sol.net_crossings());
                 (record, ok.then_some(sol.state))
             }
             Err(e) => {
@@ -656,6 +664,7 @@ mod tests {
             problem: "0".into(),
             starts: vec![],
             kept: None,
+            crossings: None,
         };
         let line = serde_json::to_string(&r).unwrap();
         std::fs::write(&path, format!("{line}\n{}", &line[..20])).unwrap();
@@ -688,6 +697,7 @@ mod tests {
             problem: "0".into(),
             starts: vec![],
             kept: None,
+            crossings: None,
         };
         std::fs::write(&path, format!("\u{feff}{}", record_line(&r))).unwrap();
         assert_eq!(read_samples(&path, true).unwrap(), vec![r.clone()]);

@@ -71,6 +71,9 @@ pub struct StartResult {
     pub psi: Option<f64>,
     pub status: SampleStatus,
     pub steps: usize,
+    /// Yarn crossings of this start's path that do not cancel (omitted when not checked).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crossings: Option<usize>,
 }
 
 /// Combine the solves of one sample from several starts (in order of preference, non-empty): the kept record is
@@ -85,6 +88,7 @@ pub fn keep(solves: Vec<(StartKind, Record)>) -> Record {
             psi: r.converged_psi(),
             status: r.status,
             steps: r.steps,
+            crossings: r.crossings,
         })
         .collect();
     let time = solves.iter().map(|(_, r)| r.time).sum();
@@ -95,17 +99,24 @@ pub fn keep(solves: Vec<(StartKind, Record)>) -> Record {
     record
 }
 
-/// The index of the record [`keep`] keeps: the converged one with the lowest Ψ̄ (the first of equal ones), else 0.
+/// The index of the record [`keep`] keeps: the converged one with the lowest Ψ̄ (the first of equal ones) among
+/// those without yarn crossings ([`Record::crossings`]: none, or not checked), else among all converged ones, else
+/// 0.
 fn kept_index<'a>(records: impl Iterator<Item = &'a Record>) -> usize {
-    let mut best: Option<(usize, f64)> = None;
+    let mut best: Option<(usize, bool, f64)> = None;
     for (i, r) in records.enumerate() {
         if let Some(p) = r.converged_psi() {
-            if best.is_none_or(|(_, b)| p < b) {
-                best = Some((i, p));
+            let clean = r.crossings.unwrap_or(0) == 0;
+            let better = match best {
+                None => true,
+                Some((_, c, b)) => (clean && !c) || (clean == c && p < b),
+            };
+            if better {
+                best = Some((i, clean, p));
             }
         }
     }
-    best.map_or(0, |(i, _)| i)
+    best.map_or(0, |(i, _, _)| i)
 }
 
 /// Whether a sample's warm and cold starts disagree: one converged and the other not, or both converged with Ψ̄
@@ -288,6 +299,7 @@ mod tests {
             problem: "0".into(),
             starts: vec![],
             kept: None,
+            crossings: None,
         }
     }
 

@@ -2,6 +2,7 @@
 //! (`02-yarn-model.md`, "Yarn-yarn contact").
 
 use super::{Tile, Want};
+use crate::contact::ccd::{crossings, Crossing};
 use crate::contact::{tile_segments, BroadPhase, ContactError, PairKernel, SegmentTopology};
 use crate::pattern::Pattern;
 use crate::rod::{RodState, YarnMaterial};
@@ -168,6 +169,24 @@ impl<'a> Tile<'a> {
             })
             .collect();
         Ok(())
+    }
+
+    /// The yarn centre-line crossings while the dofs move linearly from `y0` to `y1` at this tile's strain
+    /// ([`crate::contact::ccd`]): pairs excluded along each yarn as the contact is, centre lines met when closer
+    /// than 1e-6 r.
+    pub fn crossings(&self, y0: &[f64], y1: &[f64]) -> Result<Vec<Crossing>, ContactError> {
+        let images = self.placement.images();
+        let before = tile_segments(self.pattern, &self.home_positions(y0), &images)?;
+        let after = tile_segments(self.pattern, &self.home_positions(y1), &images)?;
+        crossings(
+            &before,
+            &after,
+            SegmentTopology::from_pattern(self.pattern),
+            &images,
+            // neighbouring segments share a vertex: they always "meet"
+            self.material.contact_exclusion.max(1),
+            1e-6 * self.contact_radius,
+        )
     }
 
     /// Number of contact pairs with a non-zero energy at dofs `y`.

@@ -284,6 +284,7 @@ fn sample_seed() -> String {
             problem: "0123456789abcdef".into(),
             starts: vec![],
             kept: None,
+            crossings: None,
         };
         text += &serde_json::to_string(&r).unwrap_or_default();
         text.push('\n');

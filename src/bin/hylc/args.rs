@@ -2,7 +2,7 @@
 
 use clap::ValueEnum;
 use hylc::micro::reference::Construction;
-use hylc::micro::{PsdStencils, SolverOptions};
+use hylc::micro::{CrossingGuard, PsdStencils, SolverOptions};
 use hylc::rod::YarnMaterial;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -30,6 +30,10 @@ pub struct SolverArgs {
     /// where the exact H + μI does not factorise at μ's floor (fallback); off: the exact Hessian with the μ shift
     #[arg(long, value_enum, default_value = "off")]
     pub psd_stencils: PsdStencilsArg,
+    /// yarn crossings along the Newton path: not checked (off), counted (count), or line-search trials that pass
+    /// two yarn centre lines through each other rejected (reject)
+    #[arg(long, value_enum, default_value = "off")]
+    pub crossings: CrossingGuard,
 }
 
 /// `--psd-stencils` ([`PsdStencils`]).
@@ -60,6 +64,7 @@ impl SolverArgs {
             projected_steps: self.projected_steps,
             keep_shift: self.keep_shift,
             psd_stencils: self.psd_stencils.into(),
+            crossings: self.crossings,
             ..Default::default()
         }
     }

@@ -6,7 +6,7 @@ use crate::strain::{load_pattern_noted, parse_strain};
 use anyhow::anyhow;
 use hylc::micro::envelope::strain_derivatives;
 use hylc::micro::solver::world_positions;
-use hylc::micro::{MacroStrain, MicroProblem, Predictor, Solution, SolverOptions};
+use hylc::micro::{CrossingGuard, MacroStrain, MicroProblem, Predictor, Solution, SolverOptions};
 use hylc::strain::StrainComponent;
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -149,6 +149,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
                     .collect();
                 println!("  stress ∂Ψ̄/∂z: {}", parts.join(", "));
             }
+            if problem.options.crossings != CrossingGuard::Off {
+                println!(
+                    "  yarn crossings: {} along the path ({} pairs not cancelling), {} line-search trials rejected",
+                    sol.crossings.len(),
+                    sol.net_crossings(),
+                    sol.rejected_crossings
+                );
+            }
             let t = &sol.timings;
             println!(
                 "  time: start {:.3} s, assembly {:.3} s, contact {:.3} s, factorisation {:.3} s, line search {:.3} s",
@@ -191,6 +199,9 @@ fn report(
         "gradient_norm": sol.gradient_norm,
         "time": sol.time,
         "predicted": predicted,
+        "crossings": (problem.options.crossings != CrossingGuard::Off).then(|| json!({
+            "events": sol.crossings.len(), "net": sol.net_crossings(), "rejected": sol.rejected_crossings,
+        })),
         "timings": { "predictor": predict_time, "start": t.start, "assembly": t.assembly, "contact": t.contact,
                      "factorization": t.factorization, "line_search": t.line_search },
     })
