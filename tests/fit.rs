@@ -71,6 +71,7 @@ fn write_samples_of(
             problem: "0000000000000000".into(),
             starts: vec![],
             kept: None,
+            crossings: None,
         };
         text += &serde_json::to_string(&r).unwrap();
         text.push('\n');

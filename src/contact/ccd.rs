@@ -187,11 +187,13 @@ pub fn crossings(
     Ok(out)
 }
 
+/// A segment pair: home segment a, segment b, the image offset of b.
+pub type PairKey = (usize, usize, [i32; 2]);
+
 /// The crossings that do not cancel: per pair (a, b, offset), the sum of the directions; the pairs with a non-zero
 /// sum (or an undirected, coplanar crossing), with that sum.
-pub fn net_crossings(events: &[Crossing]) -> Vec<((usize, usize, [i32; 2]), i32)> {
-    let mut net: std::collections::BTreeMap<(usize, usize, [i32; 2]), (i32, bool)> =
-        Default::default();
+pub fn net_crossings(events: &[Crossing]) -> Vec<(PairKey, i32)> {
+    let mut net: std::collections::BTreeMap<PairKey, (i32, bool)> = Default::default();
     for c in events {
         let e = net.entry((c.a, c.b, c.offset)).or_default();
         e.0 += c.sign as i32;

@@ -88,11 +88,16 @@ impl Record {
             && self.stress == other.stress
     }
 
-    /// Ψ̄ when the sample counts as converged: status `Converged` and a finite Ψ̄. A `Stalled`, `MaxSteps` or
-    /// `TimeLimit` record may carry the Ψ̄ of its last iterate, which is not an equilibrium, so it is no sample.
+    /// Ψ̄ when the sample counts as converged: status `Converged`, a finite Ψ̄ and no yarn crossings along its
+    /// path ([`Record::crossings`]). A `Stalled`, `MaxSteps` or `TimeLimit` record may carry the Ψ̄ of its last
+    /// iterate, which is not an equilibrium, and a solve that pulled yarns through each other found an
+    /// equilibrium of another fabric: neither is a sample (the fit counts them as excluded).
     pub fn converged_psi(&self) -> Option<f64> {
-        self.psi
-            .filter(|v| self.status == SampleStatus::Converged && v.is_finite())
+        self.psi.filter(|v| {
+            self.status == SampleStatus::Converged
+                && v.is_finite()
+                && self.crossings.unwrap_or(0) == 0
+        })
     }
 }
 
@@ -522,7 +527,9 @@ impl PlanRun<'_> {
                 record.time = sol.time + predict_time;
                 record.crossings =
                     (problem.options.crossings != CrossingGuard::Off).then(|| sol.net_crossings());
-                (record, ok.then_some(sol.state))
+                // a chain does not continue from another fabric's equilibrium
+                let clean = sol.net_crossings() == 0;
+                (record, (ok && clean).then_some(sol.state))
             }
             Err(e) => {
                 record.error = Some(e.to_string());

@@ -99,24 +99,18 @@ pub fn keep(solves: Vec<(StartKind, Record)>) -> Record {
     record
 }
 
-/// The index of the record [`keep`] keeps: the converged one with the lowest Ψ̄ (the first of equal ones) among
-/// those without yarn crossings ([`Record::crossings`]: none, or not checked), else among all converged ones, else
-/// 0.
+/// The index of the record [`keep`] keeps: the converged one with the lowest Ψ̄ (the first of equal ones), else 0.
+/// A start whose path crossed yarns does not count as converged ([`Record::converged_psi`]).
 fn kept_index<'a>(records: impl Iterator<Item = &'a Record>) -> usize {
-    let mut best: Option<(usize, bool, f64)> = None;
+    let mut best: Option<(usize, f64)> = None;
     for (i, r) in records.enumerate() {
         if let Some(p) = r.converged_psi() {
-            let clean = r.crossings.unwrap_or(0) == 0;
-            let better = match best {
-                None => true,
-                Some((_, c, b)) => (clean && !c) || (clean == c && p < b),
-            };
-            if better {
-                best = Some((i, clean, p));
+            if best.is_none_or(|(_, b)| p < b) {
+                best = Some((i, p));
             }
         }
     }
-    best.map_or(0, |(i, _, _)| i)
+    best.map_or(0, |(i, _)| i)
 }
 
 /// Whether a sample's warm and cold starts disagree: one converged and the other not, or both converged with Ψ̄
@@ -301,6 +295,46 @@ mod tests {
             kept: None,
             crossings: None,
         }
+    }
+
+    #[test]
+    fn keep_prefers_starts_without_yarn_crossings() {
+        let mut warm = record(Some(2.0), SampleStatus::Converged, 3);
+        warm.crossings = Some(0);
+        let mut cold = record(Some(0.1), SampleStatus::Converged, 40);
+        cold.start = SampleStart::Cold;
+        cold.crossings = Some(3);
+        // the lower Ψ̄ of a start that pulled yarns through each other is another fabric's
+        let k = keep(vec![
+            (StartKind::Warm, warm.clone()),
+            (StartKind::Cold, cold.clone()),
+        ]);
+        assert_eq!((k.kept, k.psi), (Some(StartKind::Warm), Some(2.0)));
+        assert_eq!(
+            k.starts.iter().map(|s| s.crossings).collect::<Vec<_>>(),
+            vec![Some(0), Some(3)]
+        );
+        assert_eq!(k.starts[1].psi, None);
+        assert_eq!(k.starts[1].status, SampleStatus::Converged);
+        // when every converged start crossed, none is a sample: the first record is kept, with its crossings
+        let mut warm_crossed = warm.clone();
+        warm_crossed.crossings = Some(1);
+        let k = keep(vec![
+            (StartKind::Warm, warm_crossed),
+            (StartKind::Cold, cold.clone()),
+        ]);
+        assert_eq!((k.kept, k.crossings), (Some(StartKind::Warm), Some(1)));
+        assert_eq!(k.converged_psi(), None);
+        // not checked counts as clean, and a clean start that did not converge is not preferred
+        warm.crossings = None;
+        let mut stalled = record(Some(0.05), SampleStatus::Stalled, 2000);
+        stalled.crossings = Some(0);
+        let k = keep(vec![
+            (StartKind::Cold, cold),
+            (StartKind::Warm, warm),
+            (StartKind::Reverse, stalled),
+        ]);
+        assert_eq!((k.kept, k.psi), (Some(StartKind::Warm), Some(2.0)));
     }
 
     #[test]

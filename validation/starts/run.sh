@@ -18,7 +18,7 @@ OUT=${OUT:-out/starts}
 REL=${REL:-1e-6}
 PLAN=${PLAN:-reduced}
 PATTERNS=${PATTERNS:-rib honeycomb}
-MODES=${MODES:-warm cold warm+cold all}
+MODES=${MODES:-warm cold warm+cold all warm-guarded cold-guarded}
 if [ ! -x "$HYLC" ]; then echo "$HYLC not found: cargo build --release first"; exit 2; fi
 for name in $PATTERNS; do
   case "$name" in
@@ -41,7 +41,9 @@ for name in $PATTERNS; do
       cold) extra=(--cold) ;;
       warm+cold) extra=(--starts warm+cold) ;;
       all) extra=(--starts all --disagreement "$REL") ;;
-      *) echo "unknown mode $mode (warm, cold, warm+cold, all)"; exit 2 ;;
+      warm-guarded) extra=(--crossings reject) ;;
+      cold-guarded) extra=(--cold --crossings reject) ;;
+      *) echo "unknown mode $mode (warm, cold, warm+cold, all, warm-guarded, cold-guarded)"; exit 2 ;;
     esac
     t0=$(date +%s.%N)
     "$HYLC" sample "$pat" --plan "$PLAN" --out "$f" ${SHARD:+--shard "$SHARD"} "${extra[@]}" \
@@ -59,7 +61,15 @@ for name in $PATTERNS; do
     [ -f "$dir/$mode.jsonl" ] || continue
     echo "-- $mode against cold-first:"
     "$HYLC" compare-samples "$dir/$mode.jsonl" "$dir/cold.jsonl" --rel "$REL" | tail -n 1
+    if [ -f "$dir/cold-guarded.jsonl" ]; then
+      echo "-- $mode against cold-first with the crossing guard:"
+      "$HYLC" compare-samples "$dir/$mode.jsonl" "$dir/cold-guarded.jsonl" --rel "$REL" | tail -n 1
+    fi
   done
+  if [ -f "$dir/warm-guarded.jsonl" ] && [ -f "$dir/cold-guarded.jsonl" ]; then
+    echo "-- warm-first vs cold-first, both with the crossing guard:"
+    "$HYLC" compare-samples "$dir/warm-guarded.jsonl" "$dir/cold-guarded.jsonl" --rel "$REL" | tail -n 1
+  fi
   python3 - "$dir" "$REL" <<'PY'
 import json, os, statistics, sys
 d, rel = sys.argv[1], float(sys.argv[2])
@@ -73,7 +83,7 @@ def wall(mode):
     return sum(float(x) for x in open(p)) if os.path.exists(p) else float("nan")
 def conv(r):
     return r["psi"] if r and r["status"] == "Converged" and r["psi"] is not None else None
-runs = {m: load(m) for m in ("warm", "cold", "warm+cold", "all")}
+runs = {m: load(m) for m in ("warm", "cold", "warm+cold", "all", "warm-guarded", "cold-guarded")}
 print("| mode | samples | converged | wall (s) | Σ solve time (s) |")
 print("| --- | --- | --- | --- | --- |")
 for m, rs in runs.items():

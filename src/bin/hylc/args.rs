@@ -31,9 +31,10 @@ pub struct SolverArgs {
     #[arg(long, value_enum, default_value = "off")]
     pub psd_stencils: PsdStencilsArg,
     /// yarn crossings along the Newton path: not checked (off), counted (count), or line-search trials that pass
-    /// two yarn centre lines through each other rejected (reject)
-    #[arg(long, value_enum, default_value = "off")]
-    pub crossings: CrossingGuard,
+    /// two yarn centre lines through each other rejected (reject); default off (`sample --starts warm+cold|all`:
+    /// reject)
+    #[arg(long, value_enum)]
+    pub crossings: Option<CrossingGuard>,
 }
 
 /// `--psd-stencils` ([`PsdStencils`]).
@@ -64,7 +65,7 @@ impl SolverArgs {
             projected_steps: self.projected_steps,
             keep_shift: self.keep_shift,
             psd_stencils: self.psd_stencils.into(),
-            crossings: self.crossings,
+            crossings: self.crossings.unwrap_or_default(),
             ..Default::default()
         }
     }

@@ -4,8 +4,8 @@
 use crate::args::{exit, SolverArgs, YarnArgs};
 use crate::printer::sample_bar;
 use crate::strain::load_pattern_noted;
-use hylc::micro::MicroProblem;
 use hylc::micro::Predictor;
+use hylc::micro::{CrossingGuard, MicroProblem};
 use hylc::sample::{parse_shard, run_plan_with, RunOptions, Starts};
 use hylc::workflow::inputs::load_plan;
 use hylc::workflow::sidecar::write_meta;
@@ -59,7 +59,12 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let shard = a.shard.as_deref().map(parse_shard).transpose()?;
     let yarn = a.yarn.material()?;
     let p = load_pattern_noted(pattern)?;
-    let problem = MicroProblem::new(p, &yarn, a.solver.options());
+    let mut options = a.solver.options();
+    if a.starts != Starts::Warm && a.solver.crossings.is_none() {
+        // a start that pulls yarns through each other ends in another fabric (issue 19, item 1)
+        options.crossings = CrossingGuard::Reject;
+    }
+    let problem = MicroProblem::new(p, &yarn, options);
     write_meta(out, pattern, &plan, &problem)?;
     let opts = RunOptions {
         cold,
