@@ -26,7 +26,12 @@ def held_out(path):
         r = json.loads(line)
         recs[r["index"]] = r
     idx = sorted(recs)[-GRID:]
-    return [recs[i] for i in idx if recs[i].get("psi") is not None and recs[i]["status"] == "Converged"]
+    crossed = sum(1 for i in idx if (recs[i].get("crossings") or 0) > 0)
+    if crossed:
+        print(f"{path}: {crossed} held-out samples excluded: their solve crossed yarns (`--crossings count`)")
+    # as Record::converged_psi: converged, and no yarn crossings along the path
+    return [recs[i] for i in idx if recs[i].get("psi") is not None and recs[i]["status"] == "Converged"
+            and (recs[i].get("crossings") or 0) == 0]
 
 
 def evaluate(material, zs):
