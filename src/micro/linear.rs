@@ -375,8 +375,12 @@ impl KktSolver {
                 .map(|v| -v)
                 .collect()
         };
+        // the residual is kept on the null space of A (its part along the rows, the constraint force, does not
+        // change z but would leave rᵀz at round-off times that force: a floor of ~1e-8 on √(rᵀz))
+        let project = null_space_projector(a);
         let mut x = vec![0.0; n];
         let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
+        project(&mut r);
         let mut z = prec(&mut solver, &r);
         let mut p = z.clone();
         let mut rz = dot(&r, &z);
@@ -407,6 +411,7 @@ impl KktSolver {
             }
             x = next;
             r.iter_mut().zip(&hp).for_each(|(ri, hi)| *ri -= alpha * hi);
+            project(&mut r);
             z = prec(&mut solver, &r);
             let rz_new = dot(&r, &z);
             if rz_new <= tol * tol * rz0 {
@@ -431,6 +436,27 @@ impl KktSolver {
             boundary,
             negative_curvature,
         })
+    }
+}
+
+/// The Euclidean projection v ← v − Aᵀ (A Aᵀ)⁻¹ A v on the null space of the rows `a` (identity without rows, or
+/// when A Aᵀ is singular).
+fn null_space_projector(a: &[Vec<f64>]) -> impl Fn(&mut [f64]) + '_ {
+    let m = a.len();
+    let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
+    let gram = DMatrix::from_fn(m, m, |i, j| dot(&a[i], &a[j]));
+    let chol = if m > 0 { gram.cholesky() } else { None };
+    move |v: &mut [f64]| {
+        let Some(c) = &chol else {
+            return;
+        };
+        let av = DVector::from_fn(m, |i, _| dot(&a[i], v));
+        let lambda = c.solve(&av);
+        for (k, row) in a.iter().enumerate() {
+            for (o, r) in v.iter_mut().zip(row) {
+                *o -= lambda[k] * r;
+            }
+        }
     }
 }
 
@@ -728,9 +754,14 @@ mod tests {
         solver
             .solve_shifted(4.0, std::slice::from_ref(&b), &a, 0)
             .unwrap();
-        let exact = solver
-            .solve_projected_kept(&b, &a, 1e-14, 100)
-            .expect("positive definite on the null space");
+        let mut k = DMatrix::zeros(n + 1, n + 1);
+        k.view_mut((0, 0), (n, n)).copy_from(&h);
+        for i in 0..n {
+            k[(n, i)] = a[0][i];
+            k[(i, n)] = a[0][i];
+        }
+        let rhs = DVector::from_fn(n + 1, |i, _| if i < n { -b[i] } else { 0.0 });
+        let exact = k.lu().solve(&rhs).unwrap();
         let step = solver
             .trust_region_kept(&b, &a, 1e3, &Euclid, 1e-14, 100)
             .unwrap();
