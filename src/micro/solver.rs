@@ -12,6 +12,9 @@
 //!    only replaced when a trial is accepted), refreshing the contact candidates when vertices have moved by more
 //!    than half the broad-phase margin, and accepts the first lower energy.
 //!
+//! With [`SolverOptions::trust_region`] (off by default), steps 4–5 are a trust-region step instead: truncated
+//! conjugate gradients on the quadratic model, preconditioned by the factorisation of step 3.
+//!
 //! Every result carries its [`Status`]; [`Solution::psi`] refuses a non-converged one.
 
 use super::elimination::Elimination;
