@@ -35,6 +35,10 @@ pub struct SolverArgs {
     /// reject)
     #[arg(long, value_enum)]
     pub crossings: Option<CrossingGuard>,
+    /// trust-region Newton steps (truncated conjugate gradients preconditioned by the shifted factorisation,
+    /// following negative curvature to the boundary) instead of the displacement limit and the backtracking
+    #[arg(long)]
+    pub trust_region: bool,
 }
 
 /// `--psd-stencils` ([`PsdStencils`]).
@@ -66,6 +70,7 @@ impl SolverArgs {
             keep_shift: self.keep_shift,
             psd_stencils: self.psd_stencils.into(),
             crossings: self.crossings.unwrap_or_default(),
+            trust_region: self.trust_region,
             ..Default::default()
         }
     }
