@@ -668,24 +668,52 @@ fn solve_columns(
 mod tests {
     use super::*;
 
-    /// H indefinite in the full space but positive definite on the null space of A: the shifted factorisation
-    /// fails at μ = 0, and the projected conjugate gradients agree with a dense solve of the KKT matrix.
-    #[test]
-    fn projected_solve_matches_dense_for_an_indefinite_h() {
-        let n = 5;
-        // diag(−3, 2, 3, 4, 5) with a coupling; A = e₀ᵀ removes the negative direction
+    /// The lower-triangle triplets (row ≥ column) of the non-zero entries of a dense symmetric matrix.
+    fn lower_triplets(h: &DMatrix<f64>) -> Vec<(usize, usize, f64)> {
+        let n = h.nrows();
+        (0..n)
+            .flat_map(|j| (j..n).map(move |i| (i, j)))
+            .filter(|&(i, j)| h[(i, j)] != 0.0)
+            .map(|(i, j)| (i, j, h[(i, j)]))
+            .collect()
+    }
+
+    /// diag(−3, 2, 3, 4, 5) with two couplings (indefinite; e₀ carries the negative curvature) and a right-hand
+    /// side.
+    fn indefinite_example() -> (DMatrix<f64>, Vec<f64>) {
         let mut h = DMatrix::from_diagonal(&DVector::from_vec(vec![-3.0, 2.0, 3.0, 4.0, 5.0]));
         h[(1, 2)] = 0.5;
         h[(2, 1)] = 0.5;
         h[(0, 3)] = 1.0;
         h[(3, 0)] = 1.0;
-        let lower: Vec<(usize, usize, f64)> = (0..n)
-            .flat_map(|j| (j..n).map(move |i| (i, j)))
-            .filter(|&(i, j)| h[(i, j)] != 0.0)
-            .map(|(i, j)| (i, j, h[(i, j)]))
-            .collect();
+        let b = (0..5).map(|i| (i as f64 * 0.9).cos()).collect();
+        (h, b)
+    }
+
+    /// The primal part x of the dense KKT solve [H Aᵀ; A 0] (x, λ) = (−b, 0).
+    fn dense_kkt(h: &DMatrix<f64>, a: &[Vec<f64>], b: &[f64]) -> DVector<f64> {
+        let (n, m) = (h.nrows(), a.len());
+        let mut k = DMatrix::zeros(n + m, n + m);
+        k.view_mut((0, 0), (n, n)).copy_from(h);
+        for (r, row) in a.iter().enumerate() {
+            for i in 0..n {
+                k[(n + r, i)] = row[i];
+                k[(i, n + r)] = row[i];
+            }
+        }
+        let rhs = DVector::from_fn(n + m, |i, _| if i < n { -b[i] } else { 0.0 });
+        k.lu().solve(&rhs).unwrap()
+    }
+
+    /// H indefinite in the full space but positive definite on the null space of A: the shifted factorisation
+    /// fails at μ = 0, and the projected conjugate gradients agree with a dense solve of the KKT matrix.
+    #[test]
+    fn projected_solve_matches_dense_for_an_indefinite_h() {
+        let n = 5;
+        // A = e₀ᵀ removes the negative direction
+        let (h, b) = indefinite_example();
+        let lower = lower_triplets(&h);
         let a = vec![vec![1.0, 0.0, 0.0, 0.0, 0.0]];
-        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.9).cos()).collect();
         let mut solver = KktSolver::default();
         solver.set_matrix(n, &lower).unwrap();
         assert_eq!(
@@ -697,14 +725,7 @@ mod tests {
             .unwrap()
             .pop()
             .unwrap();
-        let mut k = DMatrix::zeros(n + 1, n + 1);
-        k.view_mut((0, 0), (n, n)).copy_from(&h);
-        for i in 0..n {
-            k[(n, i)] = a[0][i];
-            k[(i, n)] = a[0][i];
-        }
-        let rhs = DVector::from_fn(n + 1, |i, _| if i < n { -b[i] } else { 0.0 });
-        let x = k.lu().solve(&rhs).unwrap();
+        let x = dense_kkt(&h, &a, &b);
         for i in 0..n {
             assert!((x[i] - d[i]).abs() < 1e-12, "{i}: {} vs {}", x[i], d[i]);
         }
@@ -721,17 +742,8 @@ mod tests {
     #[test]
     fn trust_region_step_follows_negative_curvature_to_the_boundary() {
         let n = 5;
-        let mut h = DMatrix::from_diagonal(&DVector::from_vec(vec![-3.0, 2.0, 3.0, 4.0, 5.0]));
-        h[(1, 2)] = 0.5;
-        h[(2, 1)] = 0.5;
-        h[(0, 3)] = 1.0;
-        h[(3, 0)] = 1.0;
-        let lower: Vec<(usize, usize, f64)> = (0..n)
-            .flat_map(|j| (j..n).map(move |i| (i, j)))
-            .filter(|&(i, j)| h[(i, j)] != 0.0)
-            .map(|(i, j)| (i, j, h[(i, j)]))
-            .collect();
-        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.9).cos()).collect();
+        let (h, b) = indefinite_example();
+        let lower = lower_triplets(&h);
         struct Euclid;
         impl TrustNorm for Euclid {
             fn norm(&self, x: &[f64]) -> f64 {
@@ -754,14 +766,7 @@ mod tests {
         solver
             .solve_shifted(4.0, std::slice::from_ref(&b), &a, 0)
             .unwrap();
-        let mut k = DMatrix::zeros(n + 1, n + 1);
-        k.view_mut((0, 0), (n, n)).copy_from(&h);
-        for i in 0..n {
-            k[(n, i)] = a[0][i];
-            k[(i, n)] = a[0][i];
-        }
-        let rhs = DVector::from_fn(n + 1, |i, _| if i < n { -b[i] } else { 0.0 });
-        let exact = k.lu().solve(&rhs).unwrap();
+        let exact = dense_kkt(&h, &a, &b);
         let step = solver
             .trust_region_kept(&b, &a, 1e3, &Euclid, 1e-14, 100)
             .unwrap();
@@ -812,29 +817,12 @@ mod tests {
                 0.0
             }
         });
-        let lower: Vec<(usize, usize, f64)> = (0..n)
-            .flat_map(|j| (j..n).map(move |i| (i, j)))
-            .filter(|&(i, j)| h[(i, j)] != 0.0)
-            .map(|(i, j)| (i, j, h[(i, j)]))
-            .collect();
+        let lower = lower_triplets(&h);
         let g: Vec<f64> = (0..n).map(|i| (i as f64 * 0.7).sin()).collect();
         let a = vec![vec![1.0; n], (0..n).map(|i| i as f64).collect::<Vec<_>>()];
         let mut solver = KktSolver::default();
         let d = solver.solve(n, &lower, 0.0, &g, &a).unwrap();
-        let m = a.len();
-        let mut k = DMatrix::zeros(n + m, n + m);
-        k.view_mut((0, 0), (n, n)).copy_from(&h);
-        for (r, row) in a.iter().enumerate() {
-            for i in 0..n {
-                k[(n + r, i)] = row[i];
-                k[(i, n + r)] = row[i];
-            }
-        }
-        let mut rhs = DVector::zeros(n + m);
-        for i in 0..n {
-            rhs[i] = -g[i];
-        }
-        let x = k.lu().solve(&rhs).unwrap();
+        let x = dense_kkt(&h, &a, &g);
         for i in 0..n {
             assert!((x[i] - d[i]).abs() < 1e-13, "{i}: {} vs {}", x[i], d[i]);
         }
