@@ -365,23 +365,13 @@ impl KktSolver {
         let llt = LltRef::new(symbolic, &self.values);
         let mut solver = ConstrainedSolve::new(llt, buf, n, a)?;
         let matrix = &self.matrix;
-        let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
-        let prec = |solver: &mut ConstrainedSolve, r: &[f64]| -> Vec<f64> {
-            solver
-                .apply(&[r])
-                .pop()
-                .expect("one column")
-                .into_iter()
-                .map(|v| -v)
-                .collect()
-        };
         // the residual is kept on the null space of A (its part along the rows, the constraint force, does not
         // change z but would leave rᵀz at round-off times that force: a floor of ~1e-8 on √(rᵀz))
         let project = null_space_projector(a);
         let mut x = vec![0.0; n];
         let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
         project(&mut r);
-        let mut z = prec(&mut solver, &r);
+        let mut z = solver.precondition(&r);
         let mut p = z.clone();
         let mut rz = dot(&r, &z);
         let rz0 = rz;
@@ -412,7 +402,7 @@ impl KktSolver {
             x = next;
             r.iter_mut().zip(&hp).for_each(|(ri, hi)| *ri -= alpha * hi);
             project(&mut r);
-            z = prec(&mut solver, &r);
+            z = solver.precondition(&r);
             let rz_new = dot(&r, &z);
             if rz_new <= tol * tol * rz0 {
                 break;
@@ -443,7 +433,6 @@ impl KktSolver {
 /// when A Aᵀ is singular).
 fn null_space_projector(a: &[Vec<f64>]) -> impl Fn(&mut [f64]) + '_ {
     let m = a.len();
-    let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
     let gram = DMatrix::from_fn(m, m, |i, j| dot(&a[i], &a[j]));
     let chol = if m > 0 { gram.cholesky() } else { None };
     move |v: &mut [f64]| {
@@ -472,20 +461,9 @@ fn projected_cg(
     max_iter: usize,
 ) -> Result<Vec<f64>, FactorError> {
     let n = lower.n;
-    let dot = |u: &[f64], v: &[f64]| u.iter().zip(v).map(|(x, y)| x * y).sum::<f64>();
     let mut x = vec![0.0; n];
     let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
-    // z = M_A⁻¹ r: M z + Aᵀλ = r, A z = 0 (apply returns the negative)
-    let prec = |solver: &mut ConstrainedSolve, r: &[f64]| -> Vec<f64> {
-        solver
-            .apply(&[r])
-            .pop()
-            .expect("one column")
-            .into_iter()
-            .map(|v| -v)
-            .collect()
-    };
-    let mut z = prec(solver, &r);
+    let mut z = solver.precondition(&r);
     let mut p = z.clone();
     let mut rz = dot(&r, &z);
     let rz0 = rz;
@@ -506,7 +484,7 @@ fn projected_cg(
             x[i] += alpha * p[i];
             r[i] -= alpha * hp[i];
         }
-        z = prec(solver, &r);
+        z = solver.precondition(&r);
         let rz_new = dot(&r, &z);
         let beta = rz_new / rz;
         for i in 0..n {
@@ -593,6 +571,17 @@ struct ConstrainedSolve<'a> {
 }
 
 impl<'a> ConstrainedSolve<'a> {
+    /// z = M_A⁻¹ r of the projected conjugate gradients: M z + Aᵀλ = r, A z = 0 ([`ConstrainedSolve::apply`]
+    /// returns the negative).
+    fn precondition(&mut self, r: &[f64]) -> Vec<f64> {
+        self.apply(&[r])
+            .pop()
+            .expect("one column")
+            .into_iter()
+            .map(|v| -v)
+            .collect()
+    }
+
     /// X_A and S⁻¹ for the constraint rows `a`; an error when S is singular.
     fn new(
         llt: LltRef<'a, usize, f64>,
@@ -650,6 +639,11 @@ impl<'a> ConstrainedSolve<'a> {
             })
             .collect()
     }
+}
+
+/// uᵀv.
+fn dot(u: &[f64], v: &[f64]) -> f64 {
+    u.iter().zip(v).map(|(x, y)| x * y).sum()
 }
 
 /// K⁻¹ applied to the columns `cols` (each of length n), as an n × cols matrix.
