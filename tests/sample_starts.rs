@@ -229,6 +229,17 @@ fn cli_starts_and_compare_samples() {
     assert!(text
         .lines()
         .all(|l| l.contains("\"starts\":[") && l.contains("\"kept\":\"")));
+    // multi-start checks every start for yarn crossings by default (`--crossings reject`): each record and
+    // start says how many (none on the plain weave); `warm` and an explicit `--crossings off` do not check
+    assert!(text
+        .lines()
+        .all(|l| l.matches("\"crossings\":0").count() >= 2));
+    assert!(!std::fs::read_to_string(&w).unwrap().contains("crossings"));
+    let wc_off = d.join("wc_off.jsonl");
+    sample(&wc_off, &["--starts", "warm+cold", "--crossings", "off"]);
+    assert!(!std::fs::read_to_string(&wc_off)
+        .unwrap()
+        .contains("crossings"));
 
     // compare-samples: the library's counts, one row per disagreement, exit 3 when there is any
     let (rw, rc) = (

@@ -42,9 +42,9 @@ pub struct SolverOptions {
     pub keep_shift: bool,
     /// Per-stencil projection of the local Hessians to positive semi-definite (`03-homogenization.md`, section 3,
     /// the alternative to the μ shift; [`crate::tile::psd`]): always, or only where the exact H + μI does not
-    /// factorise at μ's floor. Off (the default): the exact Hessian with the μ shift; on the original rib,
-    /// honeycomb and basket both variants took 9–31× the CPU time, the projected steps converging linearly (README,
-    /// "Micro-solver speed (issue 20)"). Not written to the settings JSON while off.
+    /// factorise at μ's floor. Off (the default): the exact Hessian with the μ shift, which converges faster (the projected
+    /// steps converge linearly; measured in the README, "Micro-solver speed (issue 20)"). Not written to the
+    /// settings JSON while off.
     #[serde(skip_serializing_if = "PsdStencils::is_off")]
     pub psd_stencils: PsdStencils,
     /// Yarn crossings along the Newton path ([`crate::contact::ccd`]; issue 19, item 1): not checked (the
@@ -62,10 +62,8 @@ pub struct SolverOptions {
     /// shrinks ×0.25 of the step on a rejected trial or a poor ratio of actual to predicted decrease (< 0.25)
     /// and doubles on a good one (> 0.75) that ended on the boundary. Trials are subject to
     /// [`SolverOptions::crossings`] as line-search trials are. Off (the default): the design's shifted step with
-    /// backtracking. On the five 1D chains of the reduced plan it took 0.18–0.69× the Newton steps and
-    /// 0.29–0.80× the CPU time on the original rib, honeycomb and basket, but 12 of the 450 samples moved to a
-    /// higher equilibrium (up to 7.7× Ψ̄ at the rib's II₁₁ = 160/m; README, "Micro-solver speed (issue 20)").
-    /// Not written to the settings JSON while off.
+    /// backtracking: the trust region takes fewer steps but sends some samples to higher equilibria (measured in
+    /// the README, "Micro-solver speed (issue 20)"). Not written to the settings JSON while off.
     #[serde(skip_serializing_if = "is_false")]
     pub trust_region: bool,
     /// Emit one `tracing` event (info level) per Newton step: energy, ‖g‖∞, decrement, μ, step length (`hylc

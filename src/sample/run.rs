@@ -72,8 +72,8 @@ pub struct Record {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kept: Option<StartKind>,
     /// Yarn crossings along the kept solve's Newton path that do not cancel (`--crossings count|reject`;
-    /// omitted when not checked): a solve with crossings ended in another fabric and is not kept when another
-    /// start is available.
+    /// omitted when not checked): a solve with crossings ended in another fabric, so it is no sample
+    /// ([`Record::converged_psi`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crossings: Option<usize>,
 }
@@ -525,11 +525,10 @@ impl PlanRun<'_> {
                 record.steps = sol.steps;
                 record.gradient_norm = Some(sol.gradient_norm).filter(|g| g.is_finite());
                 record.time = sol.time + predict_time;
-                record.crossings =
-                    (problem.options.crossings != CrossingGuard::Off).then(|| sol.net_crossings());
+                let net = sol.net_crossings();
+                record.crossings = (problem.options.crossings != CrossingGuard::Off).then_some(net);
                 // a chain does not continue from another fabric's equilibrium
-                let clean = sol.net_crossings() == 0;
-                (record, (ok && clean).then_some(sol.state))
+                (record, (ok && net == 0).then_some(sol.state))
             }
             Err(e) => {
                 record.error = Some(e.to_string());
