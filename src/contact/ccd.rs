@@ -20,7 +20,7 @@
 
 use super::broad::{BroadPhase, Segment, SegmentTopology};
 use super::{segment_distance_squared, ContactError};
-use crate::periodic::TileImages;
+use crate::periodic::{TileImage, TileImages};
 use nalgebra::Vector3;
 
 /// One centre-line crossing along a step: home segment `a`, segment `b` in the image at `offset`, the time
@@ -134,12 +134,37 @@ pub fn crossings(
     exclusion: usize,
     tol: f64,
 ) -> Result<Vec<Crossing>, ContactError> {
+    crossings_between((before, images), (after, images), topology, exclusion, tol)
+}
+
+/// [`crossings`] for a motion that also changes the tile transforms (a step of the macro strain): the segments
+/// `before` with the copies placed by `images_before`, then `after` with `images_after` (the same offsets in the
+/// same order). Every copy of every segment end moves on the straight line between its two world positions,
+/// T₀(x) → T₁(x′), so a pair can only meet within the step if it is closer at the start than the two ends' largest
+/// motions: a home end by |x′ − x|, a copy by at most |x′ − x| + |T₁(x) − T₀(x)|.
+pub fn crossings_between(
+    (before, images_before): (&[Segment], &TileImages),
+    (after, images_after): (&[Segment], &TileImages),
+    topology: SegmentTopology,
+    exclusion: usize,
+    tol: f64,
+) -> Result<Vec<Crossing>, ContactError> {
     if before.len() != after.len() {
         return Err(ContactError::InvalidParameter(format!(
             "crossings between {} and {} segments",
             before.len(),
             after.len()
         )));
+    }
+    let same_offsets = images_before.len() == images_after.len()
+        && images_before
+            .iter()
+            .zip(images_after.iter())
+            .all(|(a, b)| a.offset == b.offset);
+    if !same_offsets {
+        return Err(ContactError::InvalidParameter(
+            "crossings between tiles with different periodic copies".into(),
+        ));
     }
     if !(tol.is_finite() && tol > 0.0) {
         return Err(ContactError::InvalidParameter(format!(
@@ -151,34 +176,49 @@ pub fn crossings(
         .zip(after)
         .map(|(s, s2)| (s2[0] - s[0]).norm().max((s2[1] - s[1]).norm()))
         .fold(0.0f64, f64::max);
-    if !moved.is_finite() {
+    // the largest motion of a copy that the change of the transforms alone causes (0 at one strain)
+    let images_moved = if images_before == images_after {
+        0.0
+    } else {
+        images_before
+            .iter()
+            .zip(images_after.iter())
+            .flat_map(|(t0, t1)| {
+                before
+                    .iter()
+                    .flat_map(|s| [s[0], s[1]])
+                    .map(move |x| (t1.apply(&x) - t0.apply(&x)).norm())
+            })
+            .fold(0.0f64, f64::max)
+    };
+    if !(moved.is_finite() && images_moved.is_finite()) {
         return Err(ContactError::NonFinite);
     }
     // pairs closer than 2·(tol/2) + margin at `before`: every pair that can meet within the step
-    let margin = 2.0 * moved * (1.0 + 1e-9) + tol;
+    let margin = (2.0 * moved + images_moved) * (1.0 + 1e-9) + tol;
     let broad = BroadPhase::new(
         before,
         topology,
-        images.clone(),
+        images_before.clone(),
         0.5 * tol,
         margin,
         exclusion,
     )?;
     let mut out = Vec::new();
     for pair in broad.candidates() {
-        let im = images.get(pair.image);
-        let map = |s: &Segment| -> Segment { [im.apply(&s[0]), im.apply(&s[1])] };
+        let (t0, t1) = (images_before.get(pair.image), images_after.get(pair.image));
+        let map = |t: &TileImage, s: &Segment| -> Segment { [t.apply(&s[0]), t.apply(&s[1])] };
         for (time, sign) in segment_crossings(
             &before[pair.a],
             &after[pair.a],
-            &map(&before[pair.b]),
-            &map(&after[pair.b]),
+            &map(t0, &before[pair.b]),
+            &map(t1, &after[pair.b]),
             tol,
         ) {
             out.push(Crossing {
                 a: pair.a,
                 b: pair.b,
-                offset: im.offset,
+                offset: t0.offset,
                 time,
                 sign,
             });
@@ -271,5 +311,53 @@ mod tests {
         let bt = [b[0] + (b2[0] - b[0]) * t, b[1] + (b2[1] - b[1]) * t];
         let (d2, _, _) = segment_distance_squared(&a[0], &a[1], &bt[0], &bt[1]);
         assert!(d2.sqrt() < 1e-9);
+    }
+
+    #[test]
+    fn a_copy_moved_by_the_change_of_the_periods_crosses() {
+        use crate::pattern::Edge;
+        let edge = |end, offset| Edge {
+            end,
+            offset,
+            rest_length: 1.0,
+            ref_director: Vector3::z(),
+        };
+        // yarn 0: one vertex winding along y at x = 1.9; yarn 1: a segment in the plane x = 0 rising through z = 0
+        // at y = 0.5, whose copy at offset (1, 0) sits at x = p₁
+        let edges = vec![edge(0, [0, 1]), edge(2, [0, 0]), edge(1, [0, 1])];
+        let topology = SegmentTopology::from_edges(&edges);
+        let x = [v(1.9, 0.0, 0.0), v(0.0, 0.25, -0.5), v(0.0, 0.75, 0.5)];
+        let segments = |images: &TileImages| -> Vec<Segment> {
+            edges
+                .iter()
+                .enumerate()
+                .map(|(i, e)| {
+                    let k = images.index_of(e.offset).unwrap();
+                    [x[i], images.get(k).apply(&x[e.end])]
+                })
+                .collect()
+        };
+        let (wide, narrow) = (TileImages::flat([2.0, 1.0]), TileImages::flat([1.8, 1.0]));
+        let (s0, s1) = (segments(&wide), segments(&narrow));
+        // p₁ from 2 to 1.8 at fixed positions: the copy passes x = 1.9 through yarn 0
+        let moved =
+            crossings_between((&s0, &wide), (&s1, &narrow), topology.clone(), 1, 1e-9).unwrap();
+        assert!(!net_crossings(&moved).is_empty(), "{moved:?}");
+        // from 2 to 1.95: it stops short
+        let near = TileImages::flat([1.95, 1.0]);
+        let short = crossings_between(
+            (&s0, &wide),
+            (&segments(&near), &near),
+            topology.clone(),
+            1,
+            1e-9,
+        );
+        assert!(short.unwrap().is_empty());
+        // the same motion at one strain sees nothing, and copies that do not match are an error
+        assert!(crossings(&s0, &s0, topology.clone(), &wide, 1, 1e-9)
+            .unwrap()
+            .is_empty());
+        let fewer = TileImages::new(vec![TileImage::identity()]).unwrap();
+        assert!(crossings_between((&s0, &wide), (&s1, &fewer), topology, 1, 1e-9).is_err());
     }
 }

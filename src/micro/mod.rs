@@ -9,6 +9,7 @@ pub mod elimination;
 pub mod envelope;
 pub mod linear;
 pub mod options;
+pub mod path;
 pub mod predict;
 pub mod reference;
 pub mod sensitivity;

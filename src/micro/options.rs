@@ -50,7 +50,10 @@ pub struct SolverOptions {
     /// Yarn crossings along the Newton path ([`crate::contact::ccd`]; issue 19, item 1): not checked (the
     /// default), counted (each accepted step is tested; [`crate::micro::Solution::crossings`]), or rejected (a
     /// line-search trial whose step passes two yarn centre lines through each other is not accepted, so the solve
-    /// stays in the fabric it started in). Not written to the settings JSON while off.
+    /// stays in the fabric it started in). A sample chain ([`crate::sample`]) applies the same to the way from a
+    /// neighbour's equilibrium to a warm or predicted start ([`crate::micro::path`]): counted with the record's
+    /// crossings, or the start replaced by the next one that crosses nothing (predicted, warm, cold). Not written
+    /// to the settings JSON while off.
     #[serde(skip_serializing_if = "CrossingGuard::is_off")]
     pub crossings: CrossingGuard,
     /// A trust-region Newton step in place of the displacement limit and the backtracking
@@ -121,9 +124,11 @@ pub enum CrossingGuard {
     /// Not checked.
     #[default]
     Off,
-    /// Every accepted step is checked and the crossings are reported; the solve is unchanged.
+    /// Every accepted step (and a chain's start path) is checked and the crossings are reported; the solve is
+    /// unchanged.
     Count,
-    /// A line-search trial that crosses yarns is rejected (the search backtracks further).
+    /// A line-search trial that crosses yarns is rejected (the search backtracks further); a chain's start whose
+    /// path crosses is replaced by the next candidate (predicted, warm, cold).
     Reject,
 }
 

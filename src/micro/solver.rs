@@ -309,14 +309,7 @@ impl MicroProblem {
         deadline: Option<(Instant, f64)>,
     ) -> bool {
         let from = state.strain;
-        let pmax = self.pattern.periods[0].max(self.pattern.periods[1]);
-        let dz = (0..3)
-            .map(|k| (target.0[k] - from.0[k]).abs())
-            .fold(0.0, f64::max);
-        let dk = (target.0[3] - from.0[3])
-            .abs()
-            .max((target.0[4] - from.0[4]).abs());
-        let steps = ((dz / 0.05).max(dk * 2.0 * pmax / 0.25).ceil() as usize).max(1);
+        let steps = self.move_steps(&from, target);
         if from == *target {
             return true;
         }
@@ -351,6 +344,19 @@ impl MicroProblem {
             state.strain = z;
         }
         true
+    }
+
+    /// The number of equal strain steps of a move from `from` to `target` at fixed ũ and θ: in-plane components
+    /// change by at most 0.05 per step, curvatures by at most 0.25 / (2 max(p₁, p₂)).
+    pub(super) fn move_steps(&self, from: &MacroStrain, target: &MacroStrain) -> usize {
+        let pmax = self.pattern.periods[0].max(self.pattern.periods[1]);
+        let dz = (0..3)
+            .map(|k| (target.0[k] - from.0[k]).abs())
+            .fold(0.0, f64::max);
+        let dk = (target.0[3] - from.0[3])
+            .abs()
+            .max((target.0[4] - from.0[4]).abs());
+        ((dz / 0.05).max(dk * 2.0 * pmax / 0.25).ceil() as usize).max(1)
     }
 
     /// Switch between `BendY` and `BendX` at zero curvature: a rotation Q about e₃ with Q F₂ = G₂ maps the plane

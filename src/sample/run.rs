@@ -22,6 +22,7 @@
 use super::plan::{fnv1a64, Plan, Sample, Step};
 use super::starts::{keep, StartKind, StartResult, Starts};
 use super::SampleError;
+use crate::contact::ccd::{net_crossings, Crossing};
 use crate::micro::envelope::strain_derivatives;
 use crate::micro::{CrossingGuard, MacroStrain, MicroProblem, MicroState, Predictor, Status};
 use rayon::prelude::*;
@@ -470,29 +471,75 @@ impl PlanRun<'_> {
             Predictor::None => None,
         };
         let predict_time = tp.elapsed().as_secs_f64();
-        let start = if let Some(p) = predicted.as_ref() {
-            how = match self.opts.predictor {
-                Predictor::Tangent => SampleStart::Tangent,
-                _ => SampleStart::Predicted,
-            };
-            Some(p)
-        } else if let Some(s) = previous {
-            how = SampleStart::Warm;
-            Some(s)
-        } else {
-            None
-        };
-        self.solve_from(sample, start, how, predict_time)
+        // the candidates: the predicted start, then the previous equilibrium itself; with the crossing guard each
+        // start's path from the previous equilibrium is checked (`MicroProblem::start_crossings`): `reject` takes
+        // the first that crosses no yarns (else the cold start), `count` the first, its crossings counted
+        let mut candidates: Vec<(&MicroState, SampleStart)> = Vec::new();
+        if let Some(p) = predicted.as_ref() {
+            candidates.push((
+                p,
+                match self.opts.predictor {
+                    Predictor::Tangent => SampleStart::Tangent,
+                    _ => SampleStart::Predicted,
+                },
+            ));
+        }
+        candidates.extend(previous.map(|s| (s, SampleStart::Warm)));
+        let mut start = None;
+        let mut start_crossings = Vec::new();
+        if let Some(origin) = previous {
+            for (candidate, kind) in candidates {
+                let crossed = self.start_crossings(origin, candidate, &strain);
+                if self.rejects(&crossed) {
+                    continue;
+                }
+                (start, how, start_crossings) = (Some(candidate), kind, crossed);
+                break;
+            }
+        }
+        self.solve_from(sample, start, how, predict_time, start_crossings)
+    }
+
+    /// Whether a start whose path crossed `crossed` is refused (`--crossings reject` and any crossing).
+    pub(super) fn rejects(&self, crossed: &[Crossing]) -> bool {
+        self.problem.options.crossings == CrossingGuard::Reject && !crossed.is_empty()
+    }
+
+    /// The yarn crossings on the way from the equilibrium `origin` to `start` and on to `strain`
+    /// ([`crate::micro::MicroProblem::start_crossings`]); none when the guard is off. A failed check counts as a
+    /// crossing: the start is not trusted.
+    pub(super) fn start_crossings(
+        &self,
+        origin: &MicroState,
+        start: &MicroState,
+        strain: &MacroStrain,
+    ) -> Vec<Crossing> {
+        if self.problem.options.crossings == CrossingGuard::Off {
+            return Vec::new();
+        }
+        self.problem
+            .start_crossings(origin, start, strain)
+            .unwrap_or_else(|_| {
+                vec![Crossing {
+                    a: 0,
+                    b: 0,
+                    offset: [0, 0],
+                    time: f64::NAN,
+                    sign: 0,
+                }]
+            })
     }
 
     /// Solve one sample from `start` (the reference state when `None`), `how` naming the start; the record, and
-    /// the state when converged. `predict_time` (s) is added to the record's time.
+    /// the state when converged. `predict_time` (s) is added to the record's time; `start_crossings` are the
+    /// crossings of the start's own path ([`PlanRun::start_crossings`]), counted with the Newton path's.
     pub(super) fn solve_from(
         &self,
         sample: &Sample,
         start: Option<&MicroState>,
         how: SampleStart,
         predict_time: f64,
+        start_crossings: Vec<Crossing>,
     ) -> (Record, Option<MicroState>) {
         let problem = self.problem;
         let strain = MacroStrain(sample.z);
@@ -525,7 +572,9 @@ impl PlanRun<'_> {
                 record.steps = sol.steps;
                 record.gradient_norm = Some(sol.gradient_norm).filter(|g| g.is_finite());
                 record.time = sol.time + predict_time;
-                let net = sol.net_crossings();
+                let mut path = start_crossings;
+                path.extend_from_slice(&sol.crossings);
+                let net = net_crossings(&path).len();
                 record.crossings = (problem.options.crossings != CrossingGuard::Off).then_some(net);
                 // a chain does not continue from another fabric's equilibrium
                 (record, (ok && net == 0).then_some(sol.state))

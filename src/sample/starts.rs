@@ -18,7 +18,7 @@
 
 use super::plan::Step;
 use super::run::{PlanRun, Record, SampleStart, SampleStatus};
-use crate::micro::MicroState;
+use crate::micro::{MacroStrain, MicroState};
 use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::sync::atomic::Ordering;
@@ -165,7 +165,13 @@ impl PlanRun<'_> {
                 let sample = &self.samples[steps[i].sample];
                 for j in (i + 1..steps.len()).filter(|&j| steps[j].from == Some(i)) {
                     if let Some(s) = kept[j].as_ref() {
-                        let (r, st) = self.solve_from(sample, Some(s), SampleStart::Reverse, 0.0);
+                        let strain = MacroStrain(sample.z);
+                        let crossed = self.start_crossings(s, s, &strain);
+                        if self.rejects(&crossed) {
+                            continue;
+                        }
+                        let (r, st) =
+                            self.solve_from(sample, Some(s), SampleStart::Reverse, 0.0, crossed);
                         solves[i].push((StartKind::Reverse, r, st));
                     }
                 }

@@ -2,7 +2,7 @@
 //! (`02-yarn-model.md`, "Yarn-yarn contact").
 
 use super::{Tile, Want};
-use crate::contact::ccd::{crossings, Crossing};
+use crate::contact::ccd::{crossings_between, Crossing};
 use crate::contact::{tile_segments, BroadPhase, ContactError, PairKernel, SegmentTopology};
 use crate::pattern::Pattern;
 use crate::rod::{RodState, YarnMaterial};
@@ -175,14 +175,26 @@ impl<'a> Tile<'a> {
     /// ([`crate::contact::ccd`]): pairs excluded along each yarn as the contact is, centre lines met when closer
     /// than 1e-6 r.
     pub fn crossings(&self, y0: &[f64], y1: &[f64]) -> Result<Vec<Crossing>, ContactError> {
+        self.crossings_to(y0, self, y1)
+    }
+
+    /// [`Tile::crossings`] for a motion from dofs `y0` on this tile to dofs `y1` on `other`, a tile of the same
+    /// pattern at another strain (its own periodic copies and dof map; [`crossings_between`]): every copy of
+    /// every vertex moves on the straight line between its two world positions.
+    pub fn crossings_to(
+        &self,
+        y0: &[f64],
+        other: &Tile,
+        y1: &[f64],
+    ) -> Result<Vec<Crossing>, ContactError> {
         let images = self.placement.images();
         let before = tile_segments(self.pattern, &self.home_positions(y0), &images)?;
-        let after = tile_segments(self.pattern, &self.home_positions(y1), &images)?;
-        crossings(
-            &before,
-            &after,
+        let images_after = other.placement.images();
+        let after = tile_segments(other.pattern, &other.home_positions(y1), &images_after)?;
+        crossings_between(
+            (&before, &images),
+            (&after, &images_after),
             SegmentTopology::from_pattern(self.pattern),
-            &images,
             // neighbouring segments share a vertex: they always "meet"
             self.material.contact_exclusion.max(1),
             1e-6 * self.contact_radius,

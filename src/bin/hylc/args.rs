@@ -30,9 +30,9 @@ pub struct SolverArgs {
     /// where the exact H + μI does not factorise at μ's floor (fallback); off: the exact Hessian with the μ shift
     #[arg(long, value_enum, default_value = "off")]
     pub psd_stencils: PsdStencilsArg,
-    /// yarn crossings along the Newton path: not checked (off), counted (count), or line-search trials that pass
-    /// two yarn centre lines through each other rejected (reject); default off (`sample --starts warm+cold|all`:
-    /// reject)
+    /// yarn crossings along the Newton path and, in a sample chain, on the way to each warm or predicted start:
+    /// not checked (off), counted (count), or line-search trials and starts that pass two yarn centre lines
+    /// through each other rejected (reject); default off (`sample --starts warm+cold|all`: reject)
     #[arg(long, value_enum)]
     pub crossings: Option<CrossingGuard>,
     /// trust-region Newton steps (truncated conjugate gradients preconditioned by the shifted factorisation,
