@@ -235,3 +235,42 @@ fn cli_reports_bad_files_in_one_line_without_panicking() {
         m.eval(&[0.1, 0.0, 0.0, 0.0, 0.0, 0.0]).value
     );
 }
+
+/// Output piped into a reader that stops early (`hylc material … --json | head -1`) ends `hylc` quietly (SIGPIPE,
+/// as for other Unix tools), not with a panic on the broken pipe.
+#[cfg(unix)]
+#[test]
+fn a_closed_output_pipe_is_no_panic() {
+    use std::io::{BufRead, BufReader};
+    use std::process::Stdio;
+    let dir = std::env::temp_dir().join(format!("hylc-pipe-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // far more output than a pipe buffers (64 KiB): ~0.7 kB per strain
+    let zs = dir.join("z.txt");
+    let lines: Vec<String> = (0..4000)
+        .map(|i| format!("{},0,0,0,0,0", 0.0001 * i as f64))
+        .collect();
+    std::fs::write(&zs, lines.join("\n")).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hylc"))
+        .args([
+            "material",
+            "default",
+            "--z-file",
+            zs.to_str().unwrap(),
+            "--json",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    assert!(first.starts_with("{\"z\""), "{first}");
+    // the reader is gone: the rest of the output meets a closed pipe
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -138,6 +138,32 @@ fn run_writes_every_stage_and_resumes() {
     assert_eq!(summary, written);
     assert_eq!(summary["patterns"]["plain"]["samples"]["written"], 0);
 
+    // a sample file solved for another problem (an earlier version's settings) is set aside, not resumed: here
+    // the held-out grid's records carry another problem hash; the rerun moves the file beside it and solves it
+    let holdout = d.join("holdout.jsonl");
+    let text = std::fs::read_to_string(&holdout).unwrap();
+    let hash = text.split("\"problem\":\"").nth(1).unwrap()[..16].to_string();
+    std::fs::write(&holdout, text.replace(&hash, "0123456789abcdef")).unwrap();
+    let (ok, stdout, stderr) = hylc(&args);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(
+        stdout.contains("was solved for another problem"),
+        "{stdout}"
+    );
+    assert!(d.join("holdout.0123456789abcdef.jsonl").exists());
+    assert!(d.join("holdout.0123456789abcdef.meta.json").exists());
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["patterns"]["plain"]["samples"]["written"], 0);
+    assert_eq!(s["patterns"]["plain"]["samples"]["holdout"], 27);
+    assert_eq!(
+        std::fs::read_to_string(&holdout).unwrap().lines().count(),
+        27
+    );
+    assert!(!std::fs::read_to_string(&holdout)
+        .unwrap()
+        .contains("0123456789abcdef"));
+
     // scene-driven sampling from the drape's strain log: a valid plan, smaller than the default one
     let sp = dir.join("scene_plan.json");
     let log = d.join("simulate/log.jsonl");

@@ -65,6 +65,9 @@ pub struct Fit1DOptions {
     pub fd_step: f64,
     /// slope source (default finite differences)
     pub slopes: SlopeSource,
+    /// the knots' extent as a fraction of the sample range (step 2; default 0.95, the design's): beyond the last
+    /// knot the term continues linearly
+    pub extent: f64,
 }
 
 impl Default for Fit1DOptions {
@@ -78,6 +81,7 @@ impl Default for Fit1DOptions {
             minimum: MinimumAt::Zero,
             fd_step: 1e-3,
             slopes: SlopeSource::FiniteDifference,
+            extent: 0.95,
         }
     }
 }
@@ -111,6 +115,9 @@ fn check_options(o: &Fit1DOptions) -> Result<(), FitError> {
     let bad = |s: String| Err(FitError::BadOption(s));
     if o.n_knots < 2 {
         return bad(format!("n_knots = {} (need ≥ 2)", o.n_knots));
+    }
+    if !(o.extent > 0.0 && o.extent <= 1.0) {
+        return bad(format!("1D knot extent {} (need 0 < e ≤ 1)", o.extent));
     }
     super::check_common(o.eps_rel, o.min_slope, o.fd_step)
 }
@@ -180,8 +187,8 @@ impl Smoothed {
     }
 }
 
-/// Step 2's knots: the multiples k h, k = k_lo..=k_hi, of h = 0.95 (hi − lo)/(N_c − 1) inside
-/// [0.95 lo, 0.95 hi].
+/// Step 2's knots: the multiples k h, k = k_lo..=k_hi, of h = e (hi − lo)/(N_c − 1) inside [e lo, e hi], e the
+/// extent (the design's 0.95).
 struct Knots {
     t: Vec<f64>,
     h: f64,
@@ -191,16 +198,16 @@ struct Knots {
 
 impl Knots {
     /// The knots for samples spanning [lo, hi]; an error when fewer than two multiples of h fit.
-    fn new(lo: f64, hi: f64, n_knots: usize) -> Result<Knots, FitError> {
-        let h = 0.95 * (hi - lo) / (n_knots - 1) as f64;
+    fn new(lo: f64, hi: f64, n_knots: usize, extent: f64) -> Result<Knots, FitError> {
+        let h = extent * (hi - lo) / (n_knots - 1) as f64;
         // a relative tolerance keeps a multiple that lands on the bound despite rounding
-        let k_lo = (0.95 * lo / h - 1e-9).ceil() as i64;
-        let k_hi = (0.95 * hi / h + 1e-9).floor() as i64;
+        let k_lo = (extent * lo / h - 1e-9).ceil() as i64;
+        let k_hi = (extent * hi / h + 1e-9).floor() as i64;
         if k_hi - k_lo < 1 {
             return Err(FitError::Knots(format!(
                 "fewer than two multiples of h = {h} in [{}, {}]",
-                0.95 * lo,
-                0.95 * hi
+                extent * lo,
+                extent * hi
             )));
         }
         let t: Vec<f64> = (k_lo..=k_hi).map(|k| k as f64 * h).collect();
@@ -339,7 +346,7 @@ pub fn fit1d_with_stress(
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
             (l.min(v), h.max(v))
         });
-    let knots = Knots::new(lo, hi, opts.n_knots)?;
+    let knots = Knots::new(lo, hi, opts.n_knots, opts.extent)?;
     let curve: Vec<[f64; 2]> = (0..=200)
         .map(|i| {
             let u = lo + (hi - lo) * i as f64 / 200.0;
@@ -488,6 +495,10 @@ mod tests {
             },
             Fit1DOptions {
                 bandwidth_factor: -1.0,
+                ..o.clone()
+            },
+            Fit1DOptions {
+                extent: 1.5,
                 ..o.clone()
             },
         ] {

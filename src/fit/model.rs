@@ -31,6 +31,8 @@ use serde::Serialize;
 pub struct FitOptions {
     /// N_c of FIT1D (default 11)
     pub n_knots_1d: usize,
+    /// FIT1D's knot extent as a fraction of each 1D range (default 0.95, the design's)
+    pub extent_1d: f64,
     /// knots per axis of FIT2D (default 9)
     pub n_knots_2d: usize,
     /// FIT2D knot extent of the in-plane pairs (default 0.9)
@@ -65,6 +67,7 @@ impl Default for FitOptions {
     fn default() -> Self {
         FitOptions {
             n_knots_1d: 11,
+            extent_1d: 0.95,
             n_knots_2d: 9,
             extent_2d: 0.9,
             extent_2d_bending: 0.9,
@@ -83,11 +86,15 @@ impl Default for FitOptions {
 
 impl FitOptions {
     /// Settings whose spline knots cover everything sampled, for plans with few 2D samples per axis (the quick
-    /// plan of `hylc run`: 6): the knots of every 2D term span the whole sampled range (extent 1, 11 knots per
-    /// axis, so no sample lies beyond the knot box, where step 8 holds the residual constant), and the compressed
-    /// half-plane keeps its residual (FIT2D step 7′). Measurements in the README ("Set-up").
+    /// plan of `hylc run`: 6): the knots of every term span the whole sampled range (extent 1; 11 knots per 2D
+    /// axis, so no sample lies beyond the knot box, where step 8 holds the residual constant, and no 1D sample
+    /// on the linear continuation), the compressed half-plane keeps its residual (FIT2D step 7′), and the MLS
+    /// bandwidth is one median spacing instead of two (a 6 × 6 grid's spacing is a third of the range: two
+    /// spacings smooth away the biaxial stiffening). Measurements in the README ("Set-up").
     pub fn covering() -> Self {
         FitOptions {
+            extent_1d: 1.0,
+            bandwidth_factor: 1.0,
             n_knots_2d: 11,
             extent_2d: 1.0,
             n_knots_2d_bending: 11,
@@ -392,6 +399,7 @@ fn strain_scales(samples: &[Sample]) -> [f64; 5] {
 fn options_1d(k: usize, opts: &FitOptions) -> Fit1DOptions {
     Fit1DOptions {
         n_knots: opts.n_knots_1d,
+        extent: opts.extent_1d,
         bandwidth_factor: opts.bandwidth_factor,
         eps_rel: opts.eps_rel,
         min_slope: opts.min_slope,
@@ -657,6 +665,9 @@ fn meta_block(
         }
         if !opts.symmetric_shear {
             o.insert("symmetric_shear".into(), serde_json::json!(false));
+        }
+        if opts.extent_1d != FitOptions::default().extent_1d {
+            o.insert("extent_1d".into(), serde_json::json!(opts.extent_1d));
         }
     }
     meta.insert(

@@ -470,7 +470,6 @@ impl PlanRun<'_> {
             }
             Predictor::None => None,
         };
-        let predict_time = tp.elapsed().as_secs_f64();
         // the candidates: the predicted start, then the previous equilibrium itself; with the crossing guard each
         // start's path from the previous equilibrium is checked (`MicroProblem::start_crossings`): `reject` takes
         // the first that crosses no yarns (else the cold start), `count` the first, its crossings counted
@@ -497,6 +496,8 @@ impl PlanRun<'_> {
                 break;
             }
         }
+        // the record's time includes the prediction and the start checks
+        let predict_time = tp.elapsed().as_secs_f64();
         self.solve_from(sample, start, how, predict_time, start_crossings)
     }
 
@@ -531,7 +532,8 @@ impl PlanRun<'_> {
     }
 
     /// Solve one sample from `start` (the reference state when `None`), `how` naming the start; the record, and
-    /// the state when converged. `predict_time` (s) is added to the record's time; `start_crossings` are the
+    /// the state when converged. `predict_time` (s, the predictor's and the start checks') is added to the record's
+    /// time; `start_crossings` are the
     /// crossings of the start's own path ([`PlanRun::start_crossings`]), counted with the Newton path's.
     pub(super) fn solve_from(
         &self,

@@ -8,16 +8,17 @@
 
 use super::fit::{fit_samples, FitJob};
 use super::inputs::{construction_of, load_pattern, load_plan};
-use super::sidecar::write_meta;
+use super::sidecar::{meta_path, write_meta};
 use super::simulate::{execute, prepare_noted, snapshot, summary_line, Outcome, Overrides};
 use super::{write_file, Event, WorkflowError};
 use crate::fit::model::{FitOptions, FitReport};
 use crate::micro::reference::{reference_state, Construction, ReferenceOptions};
-use crate::micro::{MicroProblem, SolverOptions};
+use crate::micro::{CrossingGuard, MicroProblem, SolverOptions};
 use crate::pattern::Pattern;
 use crate::rod::YarnMaterial;
 use crate::sample::plan::{fnv1a64, InPlaneGrid};
-use crate::sample::{run_plan_with, Plan, RunOptions, RunSummary};
+use crate::sample::run::problem_hash;
+use crate::sample::{read_samples, run_plan_with, Plan, RunOptions, RunSummary};
 use serde_json::json;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -374,14 +375,57 @@ struct Sampled {
     holdout_run: RunSummary,
 }
 
+/// A sample file of an earlier run whose records were solved for another problem (e.g. by a version before the
+/// crossing guard, or with other yarn parameters) cannot be resumed: it is renamed to `<name>.<hash>.jsonl`, with
+/// its sidecar, and logged, so the run starts that file over without losing it.
+fn set_aside_other_problem(
+    file: &Path,
+    problem: &MicroProblem,
+    log: &mut Log,
+) -> Result<(), WorkflowError> {
+    if !file.exists() {
+        return Ok(());
+    }
+    let hash = problem_hash(problem);
+    let records = read_samples(file, true)?;
+    let Some(other) = records.iter().find(|r| r.problem != hash) else {
+        return Ok(());
+    };
+    let stem = file.with_extension("");
+    let aside = stem.with_extension(format!("{}.jsonl", other.problem));
+    std::fs::rename(file, &aside).map_err(|e| WorkflowError::io(file, "cannot rename", e))?;
+    let meta = meta_path(file);
+    if meta.exists() {
+        let meta_aside = stem.with_extension(format!("{}.meta.json", other.problem));
+        std::fs::rename(&meta, &meta_aside)
+            .map_err(|e| WorkflowError::io(&meta, "cannot rename", e))?;
+    }
+    log.line(&format!(
+        "samples: {} was solved for another problem ({}; this run {hash}: pattern, yarn parameters or solver \
+         settings differ); moved to {} and started over",
+        file.display(),
+        other.problem,
+        aside.display()
+    ))
+}
+
 /// Stage 3, sampling (C4): the plan into `samples.jsonl` and the held-out grid into `holdout.jsonl`, resumable.
 fn stage_sample(args: &RunConfig, dir: &Path, log: &mut Log) -> Result<Sampled, WorkflowError> {
     let t = Instant::now();
     let ref_path = dir.join("reference.pyp");
     let (q, _) = Pattern::load_pyp(&ref_path)?;
-    let problem = MicroProblem::new(q, &args.yarn, SolverOptions::default());
+    // the crossing guard: no sample (and no chain start) of another fabric (issue 19, item 1)
+    let options = SolverOptions {
+        crossings: CrossingGuard::Reject,
+        ..Default::default()
+    };
+    let problem = MicroProblem::new(q, &args.yarn, options);
     let plan = load_plan(&args.plan)?;
     let samples = dir.join("samples.jsonl");
+    let holdout = dir.join("holdout.jsonl");
+    for file in [&samples, &holdout] {
+        set_aside_other_problem(file, &problem, log)?;
+    }
     let ref_arg = ref_path.display().to_string();
     write_meta(&samples, &ref_arg, &plan, &problem)?;
     let opts = RunOptions {
@@ -393,7 +437,6 @@ fn stage_sample(args: &RunConfig, dir: &Path, log: &mut Log) -> Result<Sampled, 
         disagreement: None,
     };
     let sp = log.sample(&problem, &plan, &samples, &opts)?;
-    let holdout = dir.join("holdout.jsonl");
     let hplan = run_holdout_plan();
     write_meta(&holdout, &ref_arg, &hplan, &problem)?;
     let sh = log.sample(&problem, &hplan, &holdout, &opts)?;

@@ -82,6 +82,9 @@ pub struct Args {
     /// MLS bandwidth of every term (1D and 2D) in median sample spacings
     #[arg(long, default_value_t = 2.0)]
     bandwidth: f64,
+    /// extent of the knots of the 1D terms as a fraction of each range (beyond them a term continues linearly)
+    #[arg(long, default_value_t = 0.95)]
+    extent_1d: f64,
 }
 
 /// Where the 1D knot slopes come from (`hylc::fit::SlopeSource`).
@@ -128,6 +131,7 @@ impl Args {
             options.extent_2d_bending = e;
         }
         options.bandwidth_factor = self.bandwidth;
+        options.extent_1d = self.extent_1d;
         options
     }
 }

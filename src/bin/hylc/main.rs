@@ -87,7 +87,18 @@ fn parse() -> Result<Cli, ExitCode> {
     })
 }
 
+/// Output piped into a reader that closes early (`hylc material … --json | head`) ends the process quietly, as
+/// for other Unix tools, instead of a panic in `println!` on the broken pipe: Rust ignores SIGPIPE by default.
+fn default_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: called first in `main`, before any other thread exists; SIG_DFL is a valid disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    default_sigpipe();
     let cli = match parse() {
         Ok(cli) => cli,
         Err(code) => return code,
