@@ -164,6 +164,22 @@ fn run_writes_every_stage_and_resumes() {
         .unwrap()
         .contains("0123456789abcdef"));
 
+    // another plan (3 × 3 grids): the sample file of the first plan is set aside the same way
+    let plan2 = dir.join("smaller.json");
+    let mut p2 = p.clone();
+    p2.count_2d = 3;
+    std::fs::write(&plan2, serde_json::to_string(&p2).unwrap()).unwrap();
+    let mut args2 = args;
+    args2[4] = plan2.to_str().unwrap();
+    let (ok, stdout, stderr) = hylc(&args2);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(stdout.contains("was solved for another plan"), "{stdout}");
+    let first = format!("samples.{:016x}.jsonl", p.hash());
+    assert!(d.join(&first).exists(), "{first} missing");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["patterns"]["plain"]["samples"]["written"], 5 * 7 + 9 * 9);
+
     // scene-driven sampling from the drape's strain log: a valid plan, smaller than the default one
     let sp = dir.join("scene_plan.json");
     let log = d.join("simulate/log.jsonl");

@@ -376,35 +376,51 @@ struct Sampled {
 }
 
 /// A sample file of an earlier run whose records were solved for another problem (e.g. by a version before the
-/// crossing guard, or with other yarn parameters) cannot be resumed: it is renamed to `<name>.<hash>.jsonl`, with
-/// its sidecar, and logged, so the run starts that file over without losing it.
-fn set_aside_other_problem(
+/// crossing guard, or with other yarn parameters) or belong to another plan (e.g. `--plan reduced` after `quick`)
+/// cannot be resumed: it is renamed to `<name>.<hash>.jsonl` (the other problem's or plan's hash), with its
+/// sidecar, and logged, so the run starts that file over without losing it.
+fn set_aside_stale(
     file: &Path,
     problem: &MicroProblem,
+    plan: &Plan,
     log: &mut Log,
 ) -> Result<(), WorkflowError> {
     if !file.exists() {
         return Ok(());
     }
     let hash = problem_hash(problem);
+    let plan_hash = format!("{:016x}", plan.hash());
     let records = read_samples(file, true)?;
-    let Some(other) = records.iter().find(|r| r.problem != hash) else {
+    let stale = records.iter().find_map(|r| {
+        if r.problem != hash {
+            Some((r.problem.clone(), "another problem", hash.as_str()))
+        } else if !r.id.starts_with(&plan_hash) {
+            let other = r.id.split('-').next().unwrap_or_default().to_string();
+            Some((other, "another plan", plan_hash.as_str()))
+        } else {
+            None
+        }
+    });
+    let Some((other, what, this)) = stale else {
         return Ok(());
     };
     let stem = file.with_extension("");
-    let aside = stem.with_extension(format!("{}.jsonl", other.problem));
+    let aside = stem.with_extension(format!("{other}.jsonl"));
     std::fs::rename(file, &aside).map_err(|e| WorkflowError::io(file, "cannot rename", e))?;
     let meta = meta_path(file);
     if meta.exists() {
-        let meta_aside = stem.with_extension(format!("{}.meta.json", other.problem));
+        let meta_aside = stem.with_extension(format!("{other}.meta.json"));
         std::fs::rename(&meta, &meta_aside)
             .map_err(|e| WorkflowError::io(&meta, "cannot rename", e))?;
     }
+    let why = if what == "another problem" {
+        "pattern, yarn parameters or solver settings differ"
+    } else {
+        "the plan differs"
+    };
     log.line(&format!(
-        "samples: {} was solved for another problem ({}; this run {hash}: pattern, yarn parameters or solver \
-         settings differ); moved to {} and started over",
+        "samples: {} was solved for {what} ({other}; this run {this}: {why}); moved to {} and started over",
         file.display(),
-        other.problem,
         aside.display()
     ))
 }
@@ -423,8 +439,9 @@ fn stage_sample(args: &RunConfig, dir: &Path, log: &mut Log) -> Result<Sampled, 
     let plan = load_plan(&args.plan)?;
     let samples = dir.join("samples.jsonl");
     let holdout = dir.join("holdout.jsonl");
-    for file in [&samples, &holdout] {
-        set_aside_other_problem(file, &problem, log)?;
+    let hplan = run_holdout_plan();
+    for (file, p) in [(&samples, &plan), (&holdout, &hplan)] {
+        set_aside_stale(file, &problem, p, log)?;
     }
     let ref_arg = ref_path.display().to_string();
     write_meta(&samples, &ref_arg, &plan, &problem)?;
@@ -437,7 +454,6 @@ fn stage_sample(args: &RunConfig, dir: &Path, log: &mut Log) -> Result<Sampled, 
         disagreement: None,
     };
     let sp = log.sample(&problem, &plan, &samples, &opts)?;
-    let hplan = run_holdout_plan();
     write_meta(&holdout, &ref_arg, &hplan, &problem)?;
     let sh = log.sample(&problem, &hplan, &holdout, &opts)?;
     log.line(&format!(

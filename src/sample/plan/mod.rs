@@ -173,6 +173,9 @@ pub fn default_pairs() -> Vec<[StrainComponent; 2]> {
     ]
 }
 
+/// The smallest stretch of the quick plan's grids that pair s_x or s_y with a bending strain ([`Plan::quick`]).
+pub const QUICK_BENT_COMPRESSION: f64 = -0.44;
+
 impl Default for Plan {
     /// The design's default plan: 5 × 150 + 9 × 50² = 23 250 samples.
     fn default() -> Self {
@@ -296,12 +299,32 @@ impl Plan {
     }
 
     /// The plan of `hylc run`, the end-to-end job: 30 samples per 1D range and 6×6 grids (150 + 9 · 36 = 474
-    /// samples), default ranges and pairs, so that the whole job stays within minutes on 2 cores.
+    /// samples), default ranges and pairs, so that the whole job stays within minutes on 2 cores. The grids that
+    /// pair a stretch (s_x, s_y) with a bending strain stop the stretch at [`QUICK_BENT_COMPRESSION`]: beyond it
+    /// the generated stockinette, bent by 58–160 /m, has no equilibrium that keeps its yarns apart (the guarded
+    /// solves stall) or a jamming wall a 6 × 6 grid cannot resolve, and drapes stay far inside (README, "Set-up").
     pub fn quick() -> Self {
+        let base = Plan::default();
+        let ranges_2d = base
+            .pairs
+            .iter()
+            .map(|&[a, b]| {
+                let bent = [a, b].iter().any(|c| c.index() >= 3);
+                let range = |c: StrainComponent| {
+                    let mut r = base.ranges.get(c.index());
+                    if bent && matches!(c, StrainComponent::Sx | StrainComponent::Sy) {
+                        r[0] = r[0].max(QUICK_BENT_COMPRESSION);
+                    }
+                    r
+                };
+                [range(a), range(b)]
+            })
+            .collect();
         Plan {
             count_1d: 30,
             count_2d: 6,
-            ..Plan::default()
+            ranges_2d: Some(ranges_2d),
+            ..base
         }
     }
 
