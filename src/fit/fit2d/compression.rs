@@ -13,7 +13,8 @@
 //!    from the corner where the two zero lines cross); slopes pointing outward keep their sign or become 0;
 //! 3. the slopes across the block's outer boundary and the twists there are 0 (step 8 applied first, so it
 //!    changes nothing afterwards);
-//! 4. Fritsch–Carlson along every row and column of the block; then every patch of the block is certified
+//! 4. Fritsch–Carlson along every row and column of the block; twists 0 at knots where the value and both slopes
+//!    are 0 (minima of the non-negative excess); then every patch of the block is certified
 //!    monotone outward in both directions (the certificate of step 5, here including the patches that touch the
 //!    zero lines, whose data are zero), halving the twists of failing patches (up to 40 rounds) and then their
 //!    cross slopes (up to 60 rounds; in the limit a patch with only values is monotone because its grid lines
@@ -128,6 +129,19 @@ impl Block {
         g.bound_extrapolation();
     }
 
+    /// Twists 0 at the knots where the excess and both its slopes vanish. The excess is ≥ 0, so such a knot is
+    /// a minimum: a twist there makes the patch ≈ twist · (u − uᵢ)(v − vⱼ) near it, negative in two quadrants
+    /// (a row of zero knots left with twists of 1e-7 dipped to −1e-9 inside its patches, below the certificate's
+    /// tolerance; found by `proptests/fit2d_compression.rs`).
+    fn flat_knots_untwisted(&mut self) {
+        let g = &mut self.grid;
+        for k in 0..g.p.len() {
+            if g.p[k] == 0.0 && g.mu[k] == 0.0 && g.mv[k] == 0.0 {
+                g.muv[k] = 0.0;
+            }
+        }
+    }
+
     /// The patches failing the outward certificate: along u towards −u everywhere, along v away from row j0.
     fn failing(&self) -> Vec<((usize, usize), bool, bool)> {
         let g = &self.grid;
@@ -225,6 +239,7 @@ impl Grid {
         // step 4, grid lines: Fritsch–Carlson along every row and column, no knot exempt (the zero lines'
         // slopes are 0)
         block.grid.limit_lines(None, None);
+        block.flat_knots_untwisted();
         let rounds = block.monotone_patches();
         work.put_left_block(&block.grid);
         *self = if transpose { work.transposed() } else { work };
