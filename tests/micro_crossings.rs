@@ -9,6 +9,24 @@ use hylc::micro::{CrossingGuard, MacroStrain, MicroProblem, SolverOptions, Statu
 use hylc::rod::YarnMaterial;
 use hylc::tile::Tile;
 
+/// The generated stockinette's reference state (knitted) and its report.
+fn stockinette_reference(
+    yarn: &YarnMaterial,
+) -> (
+    hylc::pattern::Pattern,
+    hylc::micro::reference::ReferenceReport,
+) {
+    let pattern = default_pattern("stockinette").unwrap();
+    reference_state(
+        &pattern,
+        yarn,
+        Construction::Knitted,
+        &SolverOptions::default(),
+        &ReferenceOptions::default(),
+    )
+    .unwrap()
+}
+
 /// Mirroring one weave yarn's undulation moves it through every yarn it crosses: the straight-line motion has
 /// crossings, each pairing that yarn with another, and the way back has the opposite directions (net zero over
 /// both). Staying put, or moving every vertex by at most 0.2 r, crosses nothing.
@@ -60,16 +78,8 @@ fn a_weave_yarn_pushed_through_its_crossing_yarns_is_seen() {
 /// (the warm chain's 124 J/m²), far above the rest state's.
 #[test]
 fn a_cold_knit_start_that_pulls_loops_through_is_caught_and_kept_out() {
-    let pattern = default_pattern("stockinette").unwrap();
     let yarn = YarnMaterial::default();
-    let (reference, report) = reference_state(
-        &pattern,
-        &yarn,
-        Construction::Knitted,
-        &SolverOptions::default(),
-        &ReferenceOptions::default(),
-    )
-    .unwrap();
+    let (reference, report) = stockinette_reference(&yarn);
     let f0 = report.psi;
     let z = MacroStrain([0.45, 0.0, 0.96, 0.0, 0.0]);
     let solve = |crossings, max_steps| {
@@ -183,16 +193,8 @@ fn a_warm_start_moved_to_its_strain_at_fixed_displacements_is_checked() {
 /// prediction) moved there does not, nor does a small strain step.
 #[test]
 fn a_compressed_knit_chain_start_crosses_on_its_way_to_the_next_grid_point() {
-    let pattern = default_pattern("stockinette").unwrap();
     let yarn = YarnMaterial::default();
-    let (reference, _) = reference_state(
-        &pattern,
-        &yarn,
-        Construction::Knitted,
-        &SolverOptions::default(),
-        &ReferenceOptions::default(),
-    )
-    .unwrap();
+    let (reference, _) = stockinette_reference(&yarn);
     let options = SolverOptions {
         crossings: CrossingGuard::Count,
         ..Default::default()

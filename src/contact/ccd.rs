@@ -227,6 +227,20 @@ pub fn crossings_between(
     Ok(out)
 }
 
+impl Crossing {
+    /// The stand-in for a crossing check that failed (non-finite positions): counted as a crossing, so the
+    /// motion is not trusted (undirected, never cancelled).
+    pub fn untrusted() -> Self {
+        Crossing {
+            a: 0,
+            b: 0,
+            offset: [0, 0],
+            time: f64::NAN,
+            sign: 0,
+        }
+    }
+}
+
 /// A segment pair: home segment a, segment b, the image offset of b.
 pub type PairKey = (usize, usize, [i32; 2]);
 

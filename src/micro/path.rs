@@ -15,7 +15,7 @@
 //! nothing.
 
 use super::elimination::Elimination;
-use super::solver::{MicroError, MicroProblem, MicroState};
+use super::solver::{move_strain, MicroError, MicroProblem, MicroState};
 use super::strain::MacroStrain;
 use crate::contact::ccd::Crossing;
 
@@ -78,14 +78,7 @@ impl MicroProblem {
         let steps = self.move_steps(&from, target);
         let mut old = self.tile(&Elimination::in_family(&self.pattern, &from, state.family));
         for s in 1..=steps {
-            let t = s as f64 / steps as f64;
-            let z = MacroStrain(std::array::from_fn(|k| {
-                if s == steps {
-                    target.0[k]
-                } else {
-                    from.0[k] + t * (target.0[k] - from.0[k])
-                }
-            }));
+            let z = move_strain(&from, target, s, steps);
             let new = self.tile(&Elimination::in_family(&self.pattern, &z, state.family));
             out.extend(old.crossings_to(&state.y, &new, &state.y)?);
             old = new;

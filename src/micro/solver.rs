@@ -319,14 +319,7 @@ impl MicroProblem {
             if deadline.is_some_and(|(t0, limit)| t0.elapsed().as_secs_f64() > limit) {
                 return false;
             }
-            let t = s as f64 / steps as f64;
-            let z = MacroStrain(std::array::from_fn(|k| {
-                if s == steps {
-                    target.0[k]
-                } else {
-                    from.0[k] + t * (target.0[k] - from.0[k])
-                }
-            }));
+            let z = move_strain(&from, target, s, steps);
             let new = Elimination::in_family(&self.pattern, &z, state.family);
             let positions: Vec<Vector3<f64>> = (0..n)
                 .map(|v| new.position(v, [0, 0], &local(&state.y, v)))
@@ -848,6 +841,23 @@ pub fn local(y: &[f64], v: usize) -> Vector3<f64> {
 }
 
 /// The null-space constraint rows (`03-homogenization.md`, section 3), each normalised to unit length: the
+/// The strain after step `s` of `steps` equal steps from `from` to `target` (exactly `target` at the last).
+pub(super) fn move_strain(
+    from: &MacroStrain,
+    target: &MacroStrain,
+    s: usize,
+    steps: usize,
+) -> MacroStrain {
+    let t = s as f64 / steps as f64;
+    MacroStrain(std::array::from_fn(|k| {
+        if s == steps {
+            target.0[k]
+        } else {
+            from.0[k] + t * (target.0[k] - from.0[k])
+        }
+    }))
+}
+
 /// Voronoi-weighted mean displacement (3 rows) and, optionally, one no-slide row per yarn Σ wᵢ t̄ᵢ·ũᵢ with t̄ᵢ
 /// the reference unit tangent at vertex i (mean of its two edges' directions).
 pub fn null_space_rows(p: &Pattern, slide: bool) -> Vec<Vec<f64>> {

@@ -520,15 +520,7 @@ impl PlanRun<'_> {
         }
         self.problem
             .start_crossings(origin, start, strain)
-            .unwrap_or_else(|_| {
-                vec![Crossing {
-                    a: 0,
-                    b: 0,
-                    offset: [0, 0],
-                    time: f64::NAN,
-                    sign: 0,
-                }]
-            })
+            .unwrap_or_else(|_| vec![Crossing::untrusted()])
     }
 
     /// Solve one sample from `start` (the reference state when `None`), `how` naming the start; the record, and

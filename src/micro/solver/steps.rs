@@ -61,15 +61,10 @@ impl<'p> NewtonRun<'p> {
         if guard == CrossingGuard::Off {
             return false;
         }
-        let crossed = self.tile.crossings(y0, trial).unwrap_or_else(|_| {
-            vec![Crossing {
-                a: 0,
-                b: 0,
-                offset: [0, 0],
-                time: f64::NAN,
-                sign: 0,
-            }]
-        });
+        let crossed = self
+            .tile
+            .crossings(y0, trial)
+            .unwrap_or_else(|_| vec![Crossing::untrusted()]);
         if crossed.is_empty() {
             return false;
         }
