@@ -9,12 +9,14 @@
 //! constraint rows.
 
 use crate::sparse::LowerPattern;
+pub use factor::Factorization;
+use factor::{factorize_shifted, workspace, Factor};
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::linalg::cholesky::llt::factor::LltRegularization;
-use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky};
-use faer::sparse::SparseColMatRef;
-use faer::{Conj, Mat, Par, Side};
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymbolicCholesky};
+use faer::{Mat, Side};
 use nalgebra::{DMatrix, DVector};
+
+mod factor;
 
 /// Why a factorisation could not be used.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -97,9 +99,19 @@ pub struct KktSolver {
     factored: bool,
     /// Number of symbolic analyses performed (for the performance report).
     pub analyses: usize,
+    /// Which factorisation of H + μI is used (and so which shifted matrices are accepted).
+    pub factorization: Factorization,
 }
 
 impl KktSolver {
+    /// A solver that factorises with `factorization`.
+    pub fn with(factorization: Factorization) -> Self {
+        KktSolver {
+            factorization,
+            ..Default::default()
+        }
+    }
+
     /// Solve the KKT system for the lower-triangle triplets `lower` of the n×n matrix H (duplicates summed),
     /// shift `mu`, gradient `g` and constraint rows `a` (each of length n). Returns δy.
     pub fn solve(
@@ -219,7 +231,15 @@ impl KktSolver {
         let cols = rhs_list.len().max(a.len()).max(1);
         let buf = workspace(&mut self.scratch, symbolic, cols);
         self.factored = false;
-        let llt = factorize_shifted(symbolic, lower, &self.matrix, mu, &mut self.values, buf)?;
+        let llt = factorize_shifted(
+            self.factorization,
+            symbolic,
+            lower,
+            &self.matrix,
+            mu,
+            &mut self.values,
+            buf,
+        )?;
         self.factored = true;
         let mut solver = ConstrainedSolve::new(llt, buf, lower.n, a)?;
         let mut out = solver.apply(&as_slices(rhs_list));
@@ -271,14 +291,32 @@ impl KktSolver {
         self.factored = false;
         let mut mu = mu.max(f64::MIN_POSITIVE);
         let mut tries = 0;
-        while factorize_shifted(symbolic, lower, &self.matrix, mu, &mut self.values, buf).is_err() {
+        while factorize_shifted(
+            self.factorization,
+            symbolic,
+            lower,
+            &self.matrix,
+            mu,
+            &mut self.values,
+            buf,
+        )
+        .is_err()
+        {
             mu *= 10.0;
             tries += 1;
             if tries > 40 {
                 return Err(FactorError::NotPositiveDefinite);
             }
         }
-        let llt = factorize_shifted(symbolic, lower, &self.matrix, mu, &mut self.values, buf)?;
+        let llt = factorize_shifted(
+            self.factorization,
+            symbolic,
+            lower,
+            &self.matrix,
+            mu,
+            &mut self.values,
+            buf,
+        )?;
         self.factored = true;
         let mut solver = ConstrainedSolve::new(llt, buf, n, a)?;
         rhs_list
@@ -305,7 +343,7 @@ impl KktSolver {
         };
         let lower = &pattern.lower;
         let buf = workspace(&mut self.scratch, symbolic, a.len().max(1));
-        let llt = LltRef::new(symbolic, &self.values);
+        let llt = Factor::kept(self.factorization, symbolic, &self.values);
         let mut solver = ConstrainedSolve::new(llt, buf, lower.n, a)?;
         projected_cg(&mut solver, lower, &self.matrix, b, tol, max_iter)
     }
@@ -362,7 +400,7 @@ impl KktSolver {
         let lower = &pattern.lower;
         let n = lower.n;
         let buf = workspace(&mut self.scratch, symbolic, a.len().max(1));
-        let llt = LltRef::new(symbolic, &self.values);
+        let llt = Factor::kept(self.factorization, symbolic, &self.values);
         let mut solver = ConstrainedSolve::new(llt, buf, n, a)?;
         let matrix = &self.matrix;
         // the residual is kept on the null space of A (its part along the rows, the constraint force, does not
@@ -508,59 +546,11 @@ fn as_slices(rows: &[Vec<f64>]) -> Vec<&[f64]> {
     rows.iter().map(|r| r.as_slice()).collect()
 }
 
-/// The factorisation and solve workspace for `cols` right-hand sides, allocated when the kept one is smaller.
-fn workspace<'a>(
-    scratch: &'a mut Option<(usize, MemBuffer)>,
-    symbolic: &SymbolicCholesky<usize>,
-    cols: usize,
-) -> &'a mut MemBuffer {
-    if !matches!(scratch, Some((c, _)) if *c >= cols) {
-        let req = symbolic
-            .factorize_numeric_llt_scratch::<f64>(Par::Seq, Default::default())
-            .or(symbolic.solve_in_place_scratch::<f64>(cols, Par::Seq));
-        *scratch = Some((cols, MemBuffer::new(req)));
-    }
-    &mut scratch.as_mut().expect("set above").1
-}
-
-/// The numeric Cholesky factorisation of H + μI (`matrix` holds H in the pattern's value order; `values`
-/// receives the factor), sequential and without dynamic regularisation.
-fn factorize_shifted<'a>(
-    symbolic: &'a SymbolicCholesky<usize>,
-    lower: &LowerPattern,
-    matrix: &[f64],
-    mu: f64,
-    values: &'a mut Vec<f64>,
-    buf: &mut MemBuffer,
-) -> Result<LltRef<'a, usize, f64>, FactorError> {
-    let mut shifted = matrix.to_vec();
-    for &s in &lower.diag {
-        shifted[s] += mu;
-    }
-    let mat = SparseColMatRef::new(lower.symbolic(), &shifted);
-    values.clear();
-    values.resize(symbolic.len_val(), 0.0);
-    symbolic
-        .factorize_numeric_llt(
-            values,
-            mat,
-            Side::Lower,
-            LltRegularization {
-                dynamic_regularization_delta: 0.0,
-                dynamic_regularization_epsilon: 0.0,
-            },
-            Par::Seq,
-            MemStack::new(buf),
-            Default::default(),
-        )
-        .map_err(|_| FactorError::NotPositiveDefinite)
-}
-
 /// Solves with the factorised K = H + μI on the constraint space A δ = 0 by the Schur complement of the
 /// constraint rows: X_A = K⁻¹ Aᵀ, S = A X_A, and for each right-hand side b, δ = −(x + X_A λ) with x = K⁻¹ b and
 /// λ = −S⁻¹ A x.
 struct ConstrainedSolve<'a> {
-    llt: LltRef<'a, usize, f64>,
+    llt: Factor<'a>,
     buf: &'a mut MemBuffer,
     n: usize,
     a: &'a [Vec<f64>],
@@ -584,7 +574,7 @@ impl<'a> ConstrainedSolve<'a> {
 
     /// X_A and S⁻¹ for the constraint rows `a`; an error when S is singular.
     fn new(
-        llt: LltRef<'a, usize, f64>,
+        llt: Factor<'a>,
         buf: &'a mut MemBuffer,
         n: usize,
         a: &'a [Vec<f64>],
@@ -595,6 +585,9 @@ impl<'a> ConstrainedSolve<'a> {
             let s = DMatrix::from_fn(m, m, |i, j| {
                 (0..n).map(|q| a[i][q] * xa[(q, j)]).sum::<f64>()
             });
+            if !llt.kkt_inertia_ok(&s) {
+                return Err(FactorError::NotPositiveDefinite);
+            }
             Some(
                 s.clone()
                     .cholesky()
@@ -603,6 +596,9 @@ impl<'a> ConstrainedSolve<'a> {
                     .ok_or(FactorError::SingularConstraints)?,
             )
         } else {
+            if !llt.kkt_inertia_ok(&DMatrix::zeros(0, 0)) {
+                return Err(FactorError::NotPositiveDefinite);
+            }
             None
         };
         Ok(ConstrainedSolve {
@@ -647,14 +643,9 @@ fn dot(u: &[f64], v: &[f64]) -> f64 {
 }
 
 /// K⁻¹ applied to the columns `cols` (each of length n), as an n × cols matrix.
-fn solve_columns(
-    llt: &LltRef<'_, usize, f64>,
-    buf: &mut MemBuffer,
-    n: usize,
-    cols: &[&[f64]],
-) -> Mat<f64> {
+fn solve_columns(llt: &Factor<'_>, buf: &mut MemBuffer, n: usize, cols: &[&[f64]]) -> Mat<f64> {
     let mut rhs = Mat::<f64>::from_fn(n, cols.len(), |i, j| cols[j][i]);
-    llt.solve_in_place_with_conj(Conj::No, rhs.as_mut(), Par::Seq, MemStack::new(buf));
+    llt.solve_in_place(rhs.as_mut(), MemStack::new(buf));
     rhs
 }
 

@@ -69,6 +69,20 @@ pub struct SolverOptions {
     /// the README, "Micro-solver speed (issue 20)"). Not written to the settings JSON while off.
     #[serde(skip_serializing_if = "is_false")]
     pub trust_region: bool,
+    /// Inertia-controlled Newton steps (`03-homogenization.md`, section 3; issue 20), on by default: each step
+    /// first factorises H + μI at μ's floor by LDLᵀ and takes the exact constrained Newton step when the KKT
+    /// matrix has the inertia of a constrained minimum (H positive definite on the null space of the constraint
+    /// rows, even where it is indefinite along them: a yarn held back from sliding) and the energy then falls by
+    /// at least a quarter of the decrease the quadratic model predicts; otherwise the step is the design's:
+    /// μ grown ×10 until the (inertia-tested) shifted step exists, with backtracking. A backtracked step whose
+    /// predicted decrease is at round-off level (≤ 1e-11 (|E| + k_s r)) ends the solve as converged. Off: the design's rule
+    /// alone, μ grown until H + μI is positive definite in the full space (measured in the README,
+    /// "Micro-solver speed (issue 20)"). Ignored (the design's rule) with [`SolverOptions::projected_steps`],
+    /// [`SolverOptions::trust_region`] or [`SolverOptions::psd_stencils`], which were measured against it.
+    /// Written to the settings JSON only while off, so sample files made before it keep their problem hash (their
+    /// equilibria agree to the tolerance except where the README lists them).
+    #[serde(skip_serializing_if = "is_true")]
+    pub inertia: bool,
     /// Emit one `tracing` event (info level) per Newton step: energy, ‖g‖∞, decrement, μ, step length (`hylc
     /// solve --trace` prints them to stderr).
     pub trace: bool,
@@ -90,6 +104,7 @@ impl Default for SolverOptions {
             psd_stencils: PsdStencils::Off,
             crossings: CrossingGuard::Off,
             trust_region: false,
+            inertia: true,
             trace: false,
         }
     }
@@ -142,4 +157,20 @@ impl CrossingGuard {
 /// serde's `skip_serializing_if` for options that are off by default.
 fn is_false(v: &bool) -> bool {
     !*v
+}
+
+/// serde's `skip_serializing_if` for options that are on by default.
+fn is_true(v: &bool) -> bool {
+    *v
+}
+
+impl SolverOptions {
+    /// Whether the Newton steps are inertia-controlled ([`SolverOptions::inertia`] and none of the options it
+    /// gives way to).
+    pub fn inertia_steps(&self) -> bool {
+        self.inertia
+            && !self.projected_steps
+            && !self.trust_region
+            && self.psd_stencils == PsdStencils::Off
+    }
 }

@@ -6,7 +6,9 @@
 //! 1. evaluates E, the reduced gradient and Hessian at y with the frames stored at y (exact Hessian);
 //! 2. tests convergence on ‖g‖_∞ ≤ tol·k_s and on the Newton decrement;
 //! 3. solves the KKT system of the null-space constraints with the unit scaling (r θ as the angular unknown),
-//!    growing μ ×10 while H + μI is not positive definite and shrinking it after successful steps;
+//!    growing μ ×10 while H + μI is not positive definite and shrinking it after successful steps; with
+//!    [`SolverOptions::inertia`] (the default) the exact step at μ's floor comes first wherever H is positive
+//!    definite on the constraint space, kept when the energy follows its quadratic model;
 //! 4. limits the largest vertex displacement to step_factor · r · λ_min(Ī);
 //! 5. backtracks y₀ + 0.1ⁱ δy, i = 0 … 10, transporting the stored frames to each trial (the stored frames are
 //!    only replaced when a trial is accepted), refreshing the contact candidates when vertices have moved by more
@@ -18,7 +20,7 @@
 //! Every result carries its [`Status`]; [`Solution::psi`] refuses a non-converged one.
 
 use super::elimination::Elimination;
-use super::linear::{FactorError, KktSolver, TrustNorm, TrustRegionStep};
+use super::linear::{FactorError, Factorization, KktSolver, TrustNorm, TrustRegionStep};
 pub use super::options::{CrossingGuard, PsdStencils, SolverOptions};
 use super::strain::{Family, MacroStrain, StrainError};
 use crate::contact::ccd::{net_crossings, Crossing};
@@ -31,13 +33,9 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::time::Instant;
 
+mod direction;
 mod steps;
 
-/// Relative tolerance (√(rᵀz) against its start) of the projected conjugate gradients of
-/// [`SolverOptions::projected_steps`].
-const PROJECTED_TOLERANCE: f64 = 1e-10;
-/// Iteration limit of those conjugate gradients (beyond it the shifted step is taken).
-const PROJECTED_MAX_ITERATIONS: usize = 100;
 /// How a solve ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Status {
@@ -138,6 +136,9 @@ pub struct Solution {
     pub area: f64,
     /// The largest regularisation μ used (N/m).
     pub max_mu: f64,
+    /// Of the steps, the exact constrained Newton steps of [`SolverOptions::inertia`] taken where the design's rule
+    /// would have shifted μ above its floor.
+    pub exact_steps: usize,
     /// Yarn crossings of the accepted steps ([`SolverOptions::crossings`] `count`; empty otherwise).
     pub crossings: Vec<Crossing>,
     /// Line-search trials rejected because they crossed yarns ([`SolverOptions::crossings`] `reject`).
@@ -423,6 +424,7 @@ impl MicroProblem {
             },
             area: self.pattern.periods[0] * self.pattern.periods[1],
             max_mu: 0.0,
+            exact_steps: 0,
             crossings: Vec::new(),
             rejected_crossings: 0,
         }
@@ -432,6 +434,8 @@ impl MicroProblem {
     fn newton(&self, mut state: MicroState, t0: Instant) -> Result<Solution, MicroError> {
         let opts = &self.options;
         let mut run = NewtonRun::start(self, &state, t0)?;
+        let inertia = opts.inertia_steps();
+        let mut roundoff = false;
         loop {
             // 1. energy, scaled gradient and Hessian at the iterate
             let ta = Instant::now();
@@ -454,10 +458,42 @@ impl MicroProblem {
             if let Some(status) = run.stop_before_step(gnorm) {
                 return Ok(run.finish(state, status, &ev, gnorm));
             }
-            // 3. KKT step
-            let direction = match opts.psd_stencils {
-                PsdStencils::Fallback => run.fallback_direction(&ev, &g, &state)?,
-                PsdStencils::Off | PsdStencils::Always => run.direction(&ev, &g)?,
+            if roundoff {
+                return Ok(run.finish(state, Status::Converged, &ev, gnorm));
+            }
+            // 3. KKT step; with the inertia option the exact step first, kept when the energy follows its model
+            let exact = if inertia {
+                run.exact_direction(&ev, &g)?
+            } else {
+                None
+            };
+            if let Some(delta) = exact {
+                let decrement: f64 = g.iter().zip(&delta).map(|(a, b)| a * b).sum();
+                if decrement.abs() <= opts.decrement_tolerance * (energy.abs() + run.ks * run.r) {
+                    return Ok(run.finish(state, Status::Converged, &ev, gnorm));
+                }
+                if let Some(dmax_now) = run.exact_step(&mut state, delta, decrement, energy) {
+                    if opts.trace {
+                        tracing::info!(
+                            "step {}: E {energy:.15e} J, |g|inf {gnorm:.3e} N, g.d {decrement:.3e} J, exact \
+                             (mu {:.2e} kept), |d|max {:.3e} m, accepted at 1e0, symbolic analyses {}, exact \
+                             steps {}",
+                            run.steps,
+                            run.mu,
+                            dmax_now.min(run.d_max),
+                            run.kkt.analyses,
+                            run.exact
+                        );
+                    }
+                    run.steps += 1;
+                    run.mu = (run.mu / 10.0).max(run.mu_floor);
+                    continue;
+                }
+            }
+            let direction = match (inertia, opts.psd_stencils) {
+                (true, _) => run.shifted_direction(&g)?,
+                (false, PsdStencils::Fallback) => run.fallback_direction(&ev, &g, &state)?,
+                (false, PsdStencils::Off | PsdStencils::Always) => run.direction(&ev, &g)?,
             };
             let Some(mut delta) = direction else {
                 return Ok(run.finish(state, Status::Stalled, &ev, gnorm));
@@ -515,6 +551,15 @@ impl MicroProblem {
                 };
                 return Ok(run.finish(state, status, &ev, gnorm));
             }
+            // with the inertia rule, a step that had to backtrack although its predicted decrease is at round-off
+            // level ends the solve at the next state: the energy no longer resolves the steps (else such solves
+            // can creep on by decreases of a few ulps until the step limit)
+            if inertia
+                && accepted.is_some_and(|a| a < 1.0)
+                && decrement.abs() <= 1e-11 * (energy.abs() + run.ks * run.r)
+            {
+                roundoff = true;
+            }
             if !(opts.keep_shift && run.grew) {
                 run.mu = (run.mu / 10.0).max(run.mu_floor);
             }
@@ -543,6 +588,8 @@ struct NewtonRun<'p> {
     projected: usize,
     /// Whether μ had to grow in the current step.
     grew: bool,
+    /// Exact steps of [`SolverOptions::inertia`] that were accepted.
+    exact: usize,
     /// Steps that fell back to the projected Hessian ([`PsdStencils::Fallback`]).
     fallbacks: usize,
     /// Crossings of the accepted steps and trials rejected for crossing ([`SolverOptions::crossings`]).
@@ -596,7 +643,11 @@ impl<'p> NewtonRun<'p> {
             tile,
             contact_at,
             rod_structure,
-            kkt: KktSolver::default(),
+            kkt: KktSolver::with(if opts.inertia_steps() {
+                Factorization::Inertia
+            } else {
+                Factorization::Cholesky
+            }),
             timings,
             mu: 0.0,
             mu_floor: 0.0,
@@ -604,6 +655,7 @@ impl<'p> NewtonRun<'p> {
             steps: 0,
             projected: 0,
             grew: false,
+            exact: 0,
             fallbacks: 0,
             crossings: Vec::new(),
             rejected_crossings: 0,
@@ -660,124 +712,6 @@ impl<'p> NewtonRun<'p> {
         None
     }
 
-    /// The KKT step in the scaled unknowns, growing μ until H + μI factorises and the step is a descent
-    /// direction; `None` when 40 attempts fail.
-    fn direction(&mut self, ev: &TileEval, g: &[f64]) -> Result<Option<Vec<f64>>, MicroError> {
-        let tf = Instant::now();
-        self.set_newton_matrix(ev)?;
-        self.grew = false;
-        let mut delta = None;
-        for _ in 0..40 {
-            if let Some(d) = self.try_step(g)? {
-                delta = Some(d);
-                break;
-            }
-            self.mu *= 10.0;
-            self.grew = true;
-        }
-        // A shift above the floor means H is not positive definite in the full space; it may still be on the
-        // constraint space (e.g. a slide constraint holding back a yarn that would slide), where the exact
-        // Newton step exists: projected conjugate gradients with the factorisation just made as the
-        // preconditioner. Where they meet negative curvature, the shifted step stays.
-        if delta.is_some() && self.mu > self.mu_floor && self.problem.options.projected_steps {
-            let exact = self.kkt.solve_projected_kept(
-                g,
-                &self.problem.constraints,
-                PROJECTED_TOLERANCE,
-                PROJECTED_MAX_ITERATIONS,
-            );
-            if let Ok(d) = exact {
-                if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
-                    delta = Some(d);
-                    self.projected += 1;
-                }
-            }
-        }
-        self.timings.factorization += tf.elapsed().as_secs_f64();
-        self.max_mu = self.max_mu.max(self.mu);
-        Ok(delta)
-    }
-
-    /// Store the scaled Hessian of `ev` in the KKT solver (with the rod structure at the first step) and set μ's
-    /// floor from its largest diagonal entry; μ is raised to the floor.
-    fn set_newton_matrix(&mut self, ev: &TileEval) -> Result<(), MicroError> {
-        let mut lower: Vec<(usize, usize, f64)> = ev
-            .hessian
-            .as_ref()
-            .expect("asked for")
-            .iter()
-            .filter(|&&(i, j, _)| i >= j)
-            .map(|&(i, j, v)| (i, j, v * self.scale(i) * self.scale(j)))
-            .collect();
-        if self.steps == 0 {
-            lower.extend_from_slice(&self.rod_structure);
-        }
-        let diag_max = lower
-            .iter()
-            .filter(|t| t.0 == t.1)
-            .fold(0.0f64, |m, t| m.max(t.2.abs()))
-            .max(self.ks / self.r);
-        // The tile's rigid motions make H exactly singular: a factorisation at μ = 0 "succeeds" with pivots at
-        // round-off level and returns noise. μ therefore never drops below 1e-10 of the largest diagonal
-        // entry (the constraints remove those modes from the step), and at that floor two steps of iterative
-        // refinement against the unshifted H make the step an exact Newton step also along soft modes. A
-        // step that is not a descent direction counts as a failed factorisation.
-        self.mu_floor = 1e-10 * diag_max;
-        self.mu = self.mu.max(self.mu_floor);
-        self.kkt
-            .set_matrix(4 * self.n, &lower)
-            .map_err(MicroError::Linear)
-    }
-
-    /// The KKT step at the current μ for the stored matrix: `None` when H + μI does not factorise or the step is
-    /// not a descent direction.
-    fn try_step(&mut self, g: &[f64]) -> Result<Option<Vec<f64>>, MicroError> {
-        // at the floor, two refinement steps remove the shift's effect on soft modes (exact Newton)
-        let refine = if self.mu <= self.mu_floor { 2 } else { 0 };
-        let rhs = [g.to_vec()];
-        let solved = self
-            .kkt
-            .solve_shifted(self.mu, &rhs, &self.problem.constraints, refine)
-            .map(|mut v| v.pop().expect("one right-hand side"));
-        match solved {
-            Ok(d) if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 => Ok(Some(d)),
-            Ok(_) | Err(FactorError::NotPositiveDefinite) => Ok(None),
-            Err(e) => Err(MicroError::Linear(e)),
-        }
-    }
-
-    /// [`PsdStencils::Fallback`]: the exact KKT step at μ's floor when H + μ_floor I factorises and gives a descent
-    /// direction; else the step of [`NewtonRun::direction`] on the Hessian with every stencil projected to
-    /// positive semi-definite (evaluated again at `state`), which grows μ only when that one fails too.
-    fn fallback_direction(
-        &mut self,
-        ev: &TileEval,
-        g: &[f64],
-        state: &MicroState,
-    ) -> Result<Option<Vec<f64>>, MicroError> {
-        let tf = Instant::now();
-        self.set_newton_matrix(ev)?;
-        self.grew = false;
-        let saved = self.mu;
-        self.mu = self.mu_floor;
-        let exact = self.try_step(g)?;
-        self.timings.factorization += tf.elapsed().as_secs_f64();
-        if let Some(d) = exact {
-            self.max_mu = self.max_mu.max(self.mu);
-            return Ok(Some(d));
-        }
-        self.mu = saved;
-        let ta = Instant::now();
-        self.tile.psd_stencils = true;
-        let projected = self
-            .tile
-            .evaluate(&state.frames, &state.y, Want::Hessian, &Terms::ALL);
-        self.tile.psd_stencils = false;
-        self.timings.assembly += ta.elapsed().as_secs_f64();
-        self.fallbacks += 1;
-        self.direction(&projected?, g)
-    }
-
     /// Back to tile dofs (θ = y_θ / r), then the displacement limit: scale the step so that no vertex moves by
     /// more than d_max. Returns the largest vertex displacement before the limit.
     fn limit_step(&self, delta: &mut [f64]) -> f64 {
@@ -806,6 +740,7 @@ impl<'p> NewtonRun<'p> {
             timings: self.timings,
             area: self.area,
             max_mu: self.max_mu,
+            exact_steps: self.exact,
             crossings: self.crossings.clone(),
             rejected_crossings: self.rejected_crossings,
         }

@@ -39,6 +39,11 @@ pub struct SolverArgs {
     /// following negative curvature to the boundary) instead of the displacement limit and the backtracking
     #[arg(long)]
     pub trust_region: bool,
+    /// the design's shift rule alone (μ grown until H + μI is positive definite) instead of the default
+    /// inertia-controlled steps (the exact constrained Newton step wherever H is positive definite on the
+    /// constraint space and the energy follows its quadratic model)
+    #[arg(long)]
+    pub no_inertia: bool,
 }
 
 /// `--psd-stencils` ([`PsdStencils`]).
@@ -71,6 +76,7 @@ impl SolverArgs {
             psd_stencils: self.psd_stencils.into(),
             crossings: self.crossings.unwrap_or_default(),
             trust_region: self.trust_region,
+            inertia: !self.no_inertia,
             ..Default::default()
         }
     }

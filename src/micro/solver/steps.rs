@@ -14,7 +14,41 @@ const TRUST_REGION_MAX_TRIALS: usize = 20;
 /// The largest trust radius, in units of the displacement limit d_max.
 const TRUST_REGION_MAX_RADIUS: f64 = 1.0;
 
+/// [`SolverOptions::inertia`]: the exact Newton step is kept when the energy falls by at least this fraction of
+/// the decrease its quadratic model predicts; otherwise the step is the design's shifted one.
+const EXACT_STEP_RATIO: f64 = 0.25;
+
 impl<'p> NewtonRun<'p> {
+    /// [`SolverOptions::inertia`]: the exact constrained Newton step `delta` (scaled unknowns, directional
+    /// derivative `decrement` = gᵀδ) with the displacement limit, a fraction f ≤ 1 of it. On the constraint
+    /// space δᵀHδ = −gᵀδ, so the quadratic model predicts the change gᵀδ (f − f²/2); the trial is accepted (it
+    /// becomes the state) when the energy falls by at least [`EXACT_STEP_RATIO`] of that and crosses no yarns
+    /// under [`SolverOptions::crossings`]. Returns the largest vertex displacement before the limit, or `None`
+    /// (state unchanged) when the trial is refused.
+    pub(super) fn exact_step(
+        &mut self,
+        state: &mut MicroState,
+        mut delta: Vec<f64>,
+        decrement: f64,
+        energy: f64,
+    ) -> Option<f64> {
+        let tl = Instant::now();
+        let dmax_now = self.limit_step(&mut delta);
+        let f = (self.d_max / dmax_now).min(1.0);
+        let model = decrement * (f - 0.5 * f * f);
+        let trial: Vec<f64> = state.y.iter().zip(&delta).map(|(a, b)| a + b).collect();
+        let (e, positions) = self.trial_energy(state, &trial);
+        let kept = e < energy
+            && e - energy <= EXACT_STEP_RATIO * model
+            && !self.crossing_rejected(&state.y, &trial);
+        if kept {
+            self.accept_trial(state, trial, positions);
+            self.exact += 1;
+        }
+        self.timings.line_search += tl.elapsed().as_secs_f64();
+        kept.then_some(dmax_now)
+    }
+
     /// Backtracking line search on the energy along `delta` (tile dofs) from `state`: trial steps factorⁱ, the
     /// contact candidates refreshed when the vertices have moved by more than half the margin, the stored frames
     /// transported to the first trial with a lower energy, which becomes the state. Returns the accepted step.

@@ -1,0 +1,87 @@
+//! Inertia-controlled Newton steps (`SolverOptions::inertia`, the default; issue 20; `03-homogenization.md`,
+//! section 3), on the generated plain weave (no external data needed).
+
+use hylc::generate::default_pattern;
+use hylc::micro::{MacroStrain, MicroProblem, Solution, SolverOptions, Status};
+use hylc::rod::YarnMaterial;
+
+fn problem(inertia: bool) -> MicroProblem {
+    MicroProblem::new(
+        default_pattern("plain").unwrap(),
+        &YarnMaterial::default(),
+        SolverOptions {
+            inertia,
+            ..Default::default()
+        },
+    )
+}
+
+/// Both rules converge at `z` to the same Ψ̄ (1e-8 relative).
+fn same_equilibrium(z: &MacroStrain, design: &Solution, inertia: &Solution) {
+    assert_eq!(design.status, Status::Converged, "{z}");
+    assert_eq!(inertia.status, Status::Converged, "inertia {z}");
+    let (pa, pb) = (design.psi().unwrap(), inertia.psi().unwrap());
+    eprintln!(
+        "{z}: steps {} (design) vs {} (inertia, {} exact), psi {pa} vs {pb}",
+        design.steps, inertia.steps, inertia.exact_steps
+    );
+    assert!((pa - pb).abs() <= 1e-8 * pa.abs(), "{z}: {pa} vs {pb}");
+}
+
+/// The inertia rule reaches the design rule's equilibria, cold and warm along a chain in s_x and one in II₀₀, in
+/// no more Newton steps in all (it takes exact steps where the design rule shifts μ); with the rule off no exact
+/// step is taken.
+#[test]
+fn inertia_steps_reach_the_same_equilibria_in_fewer_steps() {
+    let (design, inertia) = (problem(false), problem(true));
+    let (mut steps_design, mut steps_inertia, mut exact) = (0, 0, 0);
+    for chain in [
+        (0..5)
+            .map(|k| MacroStrain::in_plane(-0.04 * k as f64, 0.1, 0.0))
+            .collect::<Vec<_>>(),
+        (0..5)
+            .map(|k| MacroStrain::new(0.0, 0.0, 0.0, 20.0 * k as f64, 0.0))
+            .collect(),
+    ] {
+        let (mut sa, mut sb) = (None, None);
+        for z in &chain {
+            let a = design.solve(z, sa.as_ref()).unwrap();
+            let b = inertia.solve(z, sb.as_ref()).unwrap();
+            same_equilibrium(z, &a, &b);
+            assert_eq!(a.exact_steps, 0, "{z}: the design rule takes no exact step");
+            steps_design += a.steps;
+            steps_inertia += b.steps;
+            exact += b.exact_steps;
+            sa = Some(a.state);
+            sb = Some(b.state);
+        }
+    }
+    eprintln!("steps: design {steps_design}, inertia {steps_inertia} ({exact} exact)");
+    assert!(steps_inertia <= steps_design);
+}
+
+/// The option is on by default and written to the settings JSON only while off, so the problem hash of sample
+/// files made before it stays; an old settings file without the key reads as on.
+#[test]
+fn inertia_is_the_default_and_serialises_only_when_off() {
+    let on = SolverOptions::default();
+    assert!(on.inertia && on.inertia_steps());
+    let json = serde_json::to_string(&on).unwrap();
+    assert!(!json.contains("inertia"), "{json}");
+    let off = SolverOptions {
+        inertia: false,
+        ..Default::default()
+    };
+    let json_off = serde_json::to_string(&off).unwrap();
+    assert!(json_off.contains("\"inertia\":false"), "{json_off}");
+    let back: SolverOptions = serde_json::from_str(&json).unwrap();
+    assert_eq!(back, on);
+    let back_off: SolverOptions = serde_json::from_str(&json_off).unwrap();
+    assert_eq!(back_off, off);
+    // the options it gives way to keep the design's rule
+    let tr = SolverOptions {
+        trust_region: true,
+        ..Default::default()
+    };
+    assert!(!tr.inertia_steps());
+}
