@@ -56,9 +56,10 @@ fn positions_of(problem: &MicroProblem, sol: &Solution) -> Vec<[f64; 3]> {
 impl PyMicroProblem {
     /// `pattern`: a Pattern, a `.pyp` path or a generated kind; `yarn`: a dict (missing keys take the defaults,
     /// `hylc.yarn_defaults()`), a yarn JSON path or None; `tolerance`, `max_steps`, `time_limit`: the stopping
-    /// rules of `hylc solve`; `quadrature`: Gauss points per segment of the contact quadrature.
+    /// rules of `hylc solve`; `quadrature`: Gauss points per segment of the contact quadrature; `inertia`: the
+    /// inertia-controlled Newton steps (`False` = `hylc solve --no-inertia`, the design's rule).
     #[new]
-    #[pyo3(signature = (pattern, yarn=None, *, tolerance=1e-8, max_steps=2000, time_limit=None, quadrature=None))]
+    #[pyo3(signature = (pattern, yarn=None, *, tolerance=1e-8, max_steps=2000, time_limit=None, quadrature=None, inertia=true))]
     fn new(
         pattern: &Bound<'_, PyAny>,
         yarn: Option<&Bound<'_, PyAny>>,
@@ -66,6 +67,7 @@ impl PyMicroProblem {
         max_steps: usize,
         time_limit: Option<f64>,
         quadrature: Option<usize>,
+        inertia: bool,
     ) -> PyResult<Self> {
         let p = pattern_of(pattern)?;
         let mut yarn = yarn_of(yarn)?;
@@ -87,6 +89,7 @@ impl PyMicroProblem {
             tolerance,
             max_steps,
             time_limit,
+            inertia,
             ..Default::default()
         };
         Ok(PyMicroProblem {

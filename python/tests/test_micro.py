@@ -47,6 +47,16 @@ def test_solve_equals_the_cli(plain, cli_json):
         assert s.energy == r["energy"]
 
 
+def test_design_rule_equals_the_cli_no_inertia(cli_json):
+    design = hylc.MicroProblem("plain", inertia=False)
+    args = ["solve", "plain", "--cold", "--no-inertia", "--json"]
+    for z in STRAINS:
+        args += ["--z", as_cli(z)]
+    for z, r in zip(STRAINS, cli_json(*args)):
+        s = design.solve(z)
+        assert (s.status, s.steps, s.psi) == (r["status"], r["steps"], r["psi"])
+
+
 def test_chain_equals_the_cli_without_predictor(plain, cli_json):
     z = np.array([[0.0, 0.0, 0.0], [0.02, 0.0, 0.0], [0.04, 0.0, 0.0]])
     args = ["solve", "plain", "--no-predictor", "--json"]

@@ -79,9 +79,10 @@ pub struct SolverOptions {
     /// alone, μ grown until H + μI is positive definite in the full space (measured in the README,
     /// "Micro-solver speed (issue 20)"). Ignored (the design's rule) with [`SolverOptions::projected_steps`],
     /// [`SolverOptions::trust_region`] or [`SolverOptions::psd_stencils`], which were measured against it.
-    /// Written to the settings JSON only while off, so sample files made before it keep their problem hash (their
-    /// equilibria agree to the tolerance except where the README lists them).
-    #[serde(skip_serializing_if = "is_true")]
+    /// Written to the settings JSON only while on: a settings record without the key (every file made before this
+    /// option) reads as off, the rule it was made with, so sample files made before it resume with it off
+    /// (`--no-inertia`) under their problem hash.
+    #[serde(default, skip_serializing_if = "is_false")]
     pub inertia: bool,
     /// Emit one `tracing` event (info level) per Newton step: energy, ‖g‖∞, decrement, μ, step length (`hylc
     /// solve --trace` prints them to stderr).
@@ -160,9 +161,6 @@ fn is_false(v: &bool) -> bool {
 }
 
 /// serde's `skip_serializing_if` for options that are on by default.
-fn is_true(v: &bool) -> bool {
-    *v
-}
 
 impl SolverOptions {
     /// Whether the Newton steps are inertia-controlled ([`SolverOptions::inertia`] and none of the options it

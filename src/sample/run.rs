@@ -289,7 +289,8 @@ pub fn run_plan_with(
             path: out.to_path_buf(),
             message: format!(
                 "sample {} was solved for another problem (hash {}, this run {hash}): \
-                 pattern, yarn parameters or solver settings differ",
+                 pattern, yarn parameters or solver settings differ (files made before the \
+                 inertia-controlled steps became the default resume with --no-inertia)",
                 r.id, r.problem
             ),
         });
