@@ -155,12 +155,10 @@ impl CrossingGuard {
     }
 }
 
-/// serde's `skip_serializing_if` for options that are off by default.
+/// serde's `skip_serializing_if` for options that are not written while off.
 fn is_false(v: &bool) -> bool {
     !*v
 }
-
-/// serde's `skip_serializing_if` for options that are on by default.
 
 impl SolverOptions {
     /// Whether the Newton steps are inertia-controlled ([`SolverOptions::inertia`] and none of the options it
