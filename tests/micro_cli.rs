@@ -146,3 +146,49 @@ fn solve_quadrature_changes_the_contact_integral() {
     assert!(p1.is_finite() && p8.is_finite());
     assert!((p1 - p8).abs() > 1e-9 * p8.abs(), "{p1} vs {p8}");
 }
+
+/// `--step-factor` (the displacement limit d_max = F · r · λ_min(Ī)) is a solver option of every command that
+/// solves: a bad value is one line naming the flag, and a sample file's settings record the value it used.
+#[test]
+fn step_factor_is_checked_and_recorded() {
+    for bad in ["0", "-1", "nan", "inf", "x"] {
+        for cmd in ["solve", "sample", "micro-grid"] {
+            let err = cli_error(&[cmd, "plain", "--step-factor", bad]);
+            assert!(
+                err.contains("--step-factor"),
+                "{cmd} --step-factor {bad}: {err}"
+            );
+        }
+    }
+    let dir = std::env::temp_dir().join("hylc_micro_cli_step_factor");
+    std::fs::create_dir_all(&dir).unwrap();
+    let plan = dir.join("plan.json");
+    let mut p = hylc::sample::Plan::reduced();
+    p.count_1d = 0;
+    p.counts_1d = Some([2, 0, 0, 0, 0]);
+    p.count_2d = 0;
+    p.pairs = vec![];
+    std::fs::write(&plan, p.canonical_json()).unwrap();
+    let settings = |factor: &str| -> serde_json::Value {
+        let out_file = dir.join(format!("s{factor}.jsonl"));
+        std::fs::remove_file(&out_file).ok();
+        let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
+            .args(["sample", "plain", "--plan", plan.to_str().unwrap(), "--out"])
+            .arg(&out_file)
+            .args(["--step-factor", factor])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let meta = out_file.with_extension("meta.json");
+        serde_json::from_str(&std::fs::read_to_string(meta).unwrap()).unwrap()
+    };
+    let (one, three) = (settings("1"), settings("3"));
+    assert_eq!(one["solver"]["step_factor"].as_f64(), Some(1.0));
+    assert_eq!(three["solver"]["step_factor"].as_f64(), Some(3.0));
+    assert_ne!(one["problem"], three["problem"]);
+    std::fs::remove_dir_all(&dir).ok();
+}

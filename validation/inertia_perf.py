@@ -8,8 +8,11 @@ accuracy table (Ψ̄ of samples converged in both, moved by more than 1e-8 relat
 Resumable: sample files and their CPU times stay in validation/inertia_perf/ (not committed); delete a pair of
 files to measure that chain again.
 
-usage: validation/inertia_perf.py [--hylc BIN] [--shards 0-4] [--extra "--crossings reject"] [--tag T] [PATTERN ...]
+usage: validation/inertia_perf.py [--hylc BIN] [--shards 0-4] [--extra "--crossings reject"] [--tag T]
+                                  [--base FLAGS] [--new FLAGS] [--labels A,B] [PATTERN ...]
   shards of the reduced plan: 0-4 are the 1D chains (s_x, s_a, s_y, II00, II11), 5-13 the 2D grids
+  --base / --new: the two variants' own flags (default `--no-inertia` / none: design rule against inertia);
+  e.g. --base "" --new "--step-factor 3" --tag _sf3 --labels "step factor 1,step factor 3"
 """
 import argparse
 import json
@@ -47,8 +50,7 @@ def run(args, pattern, shard, variant):
             os.remove(stem + ".jsonl")  # an interrupted run: its CPU time is lost, so measure it again
         cmd = [args.hylc, "sample", f"{SHARED}/data/hylc2020/patterns/{pattern}.pyp", "--plan", f"{OUT}/reduced.json",
                "--shard", f"{shard}/14", "--out", stem + ".jsonl"] + args.extra.split()
-        if variant == "off":
-            cmd.append("--no-inertia")
+        cmd += (args.base if variant == "off" else args.new).split()
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         p = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, RAYON_NUM_THREADS="1"))
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -74,8 +76,12 @@ def main():
     ap.add_argument("--shards", default="0-4")
     ap.add_argument("--extra", default="", help="more `hylc sample` options for both variants")
     ap.add_argument("--tag", default="", help="suffix of the sample files, to keep runs with other --extra apart")
+    ap.add_argument("--base", default="--no-inertia", help="flags of the baseline variant (files `_off`)")
+    ap.add_argument("--new", default="", help="flags of the new variant (files `_on`)")
+    ap.add_argument("--labels", default="design rule,inertia", help="the two variants' names in the tables")
     ap.add_argument("patterns", nargs="*", default=ALL)
     args = ap.parse_args()
+    base, new = args.labels.split(",")
     if not os.path.isdir(f"{SHARED}/data/hylc2020/patterns"):
         print(f"skipped: {SHARED}/data/hylc2020/patterns not found (set HYLC_SHARED)")
         return
@@ -126,12 +132,13 @@ def main():
                 crossed = f"{a.get('crossings', '–')} / {b.get('crossings', '–')}"
                 moved_big.append(f"| {pat} | {a['index']} | ({z}) | {a['psi']:.5g} | {b['psi']:.5g} | {d:+.2g} | "
                                  f"{a['steps']} / {b['steps']} | {crossed} |")
-    print(f"Chains: {', '.join(CHAINS[k] for k in shards)}; options: {args.extra or '(defaults)'}\n")
-    print("| pattern | chains | design rule: warm steps, median / mean | total steps | CPU (s) | "
-          "inertia: warm steps, median / mean | total steps | CPU (s) | CPU ratio design / inertia |")
+    print(f"Chains: {', '.join(CHAINS[k] for k in shards)}; options: {args.extra or '(defaults)'}; "
+          f"{base}: {args.base or '(defaults)'}; {new}: {args.new or '(defaults)'}\n")
+    print(f"| pattern | chains | {base}: warm steps, median / mean | total steps | CPU (s) | "
+          f"{new}: warm steps, median / mean | total steps | CPU (s) | CPU ratio {base} / {new} |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     print("\n".join(speed))
-    print("\n| pattern | warm median per chain, design rule | warm median per chain, inertia |")
+    print(f"\n| pattern | warm median per chain, {base} | warm median per chain, {new} |")
     print("| --- | --- | --- |")
     print("\n".join(per_chain))
     print("\n| pattern | converged in both | Ψ̄ moved > 1e-8 relative | of them ≤ 1e-6 / ≤ 1e-4 / ≤ 1e-2 / more | "
@@ -139,8 +146,8 @@ def main():
     print("| --- | --- | --- | --- | --- | --- | --- | --- |")
     print("\n".join(accuracy))
     if moved_big:
-        print("\n| pattern | index | z | Ψ̄ design rule | Ψ̄ inertia | relative | steps design / inertia | "
-              "crossings design / inertia |")
+        print(f"\n| pattern | index | z | Ψ̄ {base} | Ψ̄ {new} | relative | steps {base} / {new} | "
+              f"crossings {base} / {new} |")
         print("| --- | --- | --- | --- | --- | --- | --- | --- |")
         print("\n".join(moved_big))
 

@@ -44,6 +44,9 @@ pub struct SolverArgs {
     /// constraint space and the energy follows its quadratic model)
     #[arg(long)]
     pub no_inertia: bool,
+    /// displacement limit factor: no vertex moves more than F · r · λ_min(Ī) per Newton step (the design's 1)
+    #[arg(long, default_value_t = 1.0, value_name = "F", value_parser = positive_finite, allow_hyphen_values = true)]
+    pub step_factor: f64,
 }
 
 /// `--psd-stencils` ([`PsdStencils`]).
@@ -77,6 +80,7 @@ impl SolverArgs {
             crossings: self.crossings.unwrap_or_default(),
             trust_region: self.trust_region,
             inertia: !self.no_inertia,
+            step_factor: self.step_factor,
             ..Default::default()
         }
     }
@@ -148,6 +152,15 @@ pub fn exit(ok: bool, code: u8) -> ExitCode {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(code)
+    }
+}
+
+/// A clap value parser: a finite number > 0.
+fn positive_finite(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        Ok(v) => Err(format!("expected a finite number > 0, got {v}")),
+        Err(e) => Err(format!("{e}")),
     }
 }
 

@@ -35,9 +35,6 @@ pub struct Args {
     solver: SolverArgs,
     #[command(flatten)]
     yarn: YarnArgs,
-    /// displacement limit factor (times r λ_min(I))
-    #[arg(long, default_value_t = 1.0)]
-    step_factor: f64,
     /// line-search backtracking factor (trial steps factor^i down to 1e-10)
     #[arg(long, default_value_t = 0.1)]
     backtracking: f64,
@@ -71,7 +68,6 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     }
     let options = SolverOptions {
         trace: a.trace,
-        step_factor: a.step_factor,
         backtracking: a.backtracking,
         slide_constraints: !a.no_slide_constraints,
         ..a.solver.options()
