@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::cli_error;
+use common::{cli_error, cli_ok};
 use hylc::fit::model::strain6;
 use hylc::material::synthetic::default_material;
 use hylc::material::Material;
@@ -275,15 +275,7 @@ fn fit_bad_input_is_one_line() {
     let err = cli_error(&["fit", &sp, "--density=-1"]);
     assert!(err.contains("density"), "{err}");
     // with the density it works, and the reduced plan is recognised from the ids
-    let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
-        .args(["fit", &sp, "--density", "0.3", "--no-plots"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    cli_ok(&["fit", &sp, "--density", "0.3", "--no-plots"]);
     std::fs::remove_dir_all(&d).ok();
 }
 

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::cli_error;
+use common::{cli_error, cli_ok};
 use std::process::Command;
 
 #[test]
@@ -172,17 +172,16 @@ fn step_factor_is_checked_and_recorded() {
     let settings = |factor: &str| -> serde_json::Value {
         let out_file = dir.join(format!("s{factor}.jsonl"));
         std::fs::remove_file(&out_file).ok();
-        let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
-            .args(["sample", "plain", "--plan", plan.to_str().unwrap(), "--out"])
-            .arg(&out_file)
-            .args(["--step-factor", factor])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        cli_ok(&[
+            "sample",
+            "plain",
+            "--plan",
+            plan.to_str().unwrap(),
+            "--out",
+            out_file.to_str().unwrap(),
+            "--step-factor",
+            factor,
+        ]);
         let meta = out_file.with_extension("meta.json");
         serde_json::from_str(&std::fs::read_to_string(meta).unwrap()).unwrap()
     };

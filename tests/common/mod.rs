@@ -16,6 +16,21 @@ pub fn shared_or_skip(test: &str) -> Option<PathBuf> {
     }
 }
 
+/// Run the `hylc` binary with `args` and assert that it succeeds (stderr in the failure message).
+pub fn cli_ok(args: &[&str]) -> std::process::Output {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hylc"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "hylc {}: {}",
+        args.join(" "),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// Run the `hylc` binary with `args`, assert that it fails with exit code 2 and a one-line message, and return
 /// that message (stderr).
 pub fn cli_error(args: &[&str]) -> String {
