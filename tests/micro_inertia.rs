@@ -80,3 +80,40 @@ fn inertia_is_the_default_and_an_old_settings_record_reads_as_off() {
     let back_off: SolverOptions = serde_json::from_str(&json_off).unwrap();
     assert_eq!(back_off, off);
 }
+
+/// `SolverOptions::exact_backoff`: on a compressed, bent plain weave solved cold (a solve whose exact attempts are
+/// refused in runs) the skipped attempts change the path but not the equilibrium (Ψ̄ to 1e-8); the option is
+/// off by default and written to the settings JSON only while on.
+#[test]
+fn exact_backoff_changes_the_path_not_the_equilibrium() {
+    let z = MacroStrain::new(-0.4, 0.0, 0.0, 0.0, 150.0);
+    let every_step = problem(true).solve(&z, None).unwrap();
+    let backoff = MicroProblem::new(
+        default_pattern("plain").unwrap(),
+        &YarnMaterial::default(),
+        SolverOptions {
+            exact_backoff: true,
+            ..Default::default()
+        },
+    )
+    .solve(&z, None)
+    .unwrap();
+    same_equilibrium(&z, &every_step, &backoff);
+    assert_ne!(
+        (every_step.steps, every_step.exact_steps),
+        (backoff.steps, backoff.exact_steps),
+        "the backoff skipped no exact attempt"
+    );
+    let off = SolverOptions::default();
+    assert!(!off.exact_backoff);
+    assert!(!serde_json::to_string(&off)
+        .unwrap()
+        .contains("exact_backoff"));
+    let on = SolverOptions {
+        exact_backoff: true,
+        ..Default::default()
+    };
+    let json = serde_json::to_string(&on).unwrap();
+    assert!(json.contains("\"exact_backoff\":true"), "{json}");
+    assert_eq!(serde_json::from_str::<SolverOptions>(&json).unwrap(), on);
+}

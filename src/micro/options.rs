@@ -84,6 +84,14 @@ pub struct SolverOptions {
     /// (`--no-inertia`) under their problem hash.
     #[serde(default, skip_serializing_if = "is_false")]
     pub inertia: bool,
+    /// With [`SolverOptions::inertia`]: after an exact step that was refused (the KKT matrix at μ's floor without
+    /// the inertia of a constrained minimum, or the energy not following its model), skip the exact attempt for
+    /// the next 1, 2, 4, …, [`EXACT_BACKOFF_MAX`] steps (doubled after each consecutive refusal, back to every
+    /// step after an accepted exact step), so that a solve deep in an indefinite region stops paying a
+    /// factorisation that fails again. Off (the default): the exact attempt at every step where μ is above its
+    /// floor. Not written to the settings JSON while off.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub exact_backoff: bool,
     /// Emit one `tracing` event (info level) per Newton step: energy, ‖g‖∞, decrement, μ, step length (`hylc
     /// solve --trace` prints them to stderr).
     pub trace: bool,
@@ -106,10 +114,14 @@ impl Default for SolverOptions {
             crossings: CrossingGuard::Off,
             trust_region: false,
             inertia: true,
+            exact_backoff: false,
             trace: false,
         }
     }
 }
+
+/// The longest run of Newton steps without an exact attempt under [`SolverOptions::exact_backoff`].
+pub const EXACT_BACKOFF_MAX: usize = 16;
 
 /// When the Newton matrix is built from per-stencil positive semi-definite projections of the local Hessians
 /// ([`SolverOptions::psd_stencils`]).

@@ -21,7 +21,7 @@
 
 use super::elimination::Elimination;
 use super::linear::{FactorError, Factorization, KktSolver, TrustNorm, TrustRegionStep};
-pub use super::options::{CrossingGuard, PsdStencils, SolverOptions};
+pub use super::options::{CrossingGuard, PsdStencils, SolverOptions, EXACT_BACKOFF_MAX};
 use super::strain::{Family, MacroStrain, StrainError};
 use crate::contact::ccd::{net_crossings, Crossing};
 use crate::contact::ContactError;
@@ -462,11 +462,14 @@ impl MicroProblem {
                 return Ok(run.finish(state, Status::Converged, &ev, gnorm));
             }
             // 3. KKT step; with the inertia option the exact step first, kept when the energy follows its model
-            let exact = if inertia {
+            // (under the exact-step backoff, not while the last refusal's skipped steps last)
+            let attempt = inertia && run.skip_exact == 0;
+            let exact = if attempt {
                 run.exact_direction(&ev, &g)?
             } else {
                 None
             };
+            let attempted = attempt && run.mu > run.mu_floor;
             if let Some(delta) = exact {
                 let decrement: f64 = g.iter().zip(&delta).map(|(a, b)| a * b).sum();
                 if decrement.abs() <= opts.decrement_tolerance * (energy.abs() + run.ks * run.r) {
@@ -487,11 +490,20 @@ impl MicroProblem {
                     }
                     run.steps += 1;
                     run.mu = (run.mu / 10.0).max(run.mu_floor);
+                    run.backoff = 0;
                     continue;
                 }
             }
+            if opts.exact_backoff && attempted {
+                // refused: skip the next 1, 2, 4, … steps' attempts
+                run.backoff = (2 * run.backoff).clamp(1, EXACT_BACKOFF_MAX);
+                run.skip_exact = run.backoff;
+            } else if run.skip_exact > 0 {
+                run.skip_exact -= 1;
+            }
             let direction = match (inertia, opts.psd_stencils) {
-                (true, _) => run.shifted_direction(&g)?,
+                (true, _) if attempt => run.shifted_direction(&g)?,
+                (true, _) => run.direction(&ev, &g)?,
                 (false, PsdStencils::Fallback) => run.fallback_direction(&ev, &g, &state)?,
                 (false, PsdStencils::Off | PsdStencils::Always) => run.direction(&ev, &g)?,
             };
@@ -590,6 +602,10 @@ struct NewtonRun<'p> {
     grew: bool,
     /// Exact steps of [`SolverOptions::inertia`] that were accepted.
     exact: usize,
+    /// [`SolverOptions::exact_backoff`]: steps whose exact attempt is still skipped, and the length of the last
+    /// skip (0 after an accepted exact step).
+    skip_exact: usize,
+    backoff: usize,
     /// Steps that fell back to the projected Hessian ([`PsdStencils::Fallback`]).
     fallbacks: usize,
     /// Crossings of the accepted steps and trials rejected for crossing ([`SolverOptions::crossings`]).
@@ -656,6 +672,8 @@ impl<'p> NewtonRun<'p> {
             projected: 0,
             grew: false,
             exact: 0,
+            skip_exact: 0,
+            backoff: 0,
             fallbacks: 0,
             crossings: Vec::new(),
             rejected_crossings: 0,

@@ -44,6 +44,10 @@ pub struct SolverArgs {
     /// constraint space and the energy follows its quadratic model)
     #[arg(long)]
     pub no_inertia: bool,
+    /// with the inertia-controlled steps: after a refused exact step, skip the exact attempt for the next 1, 2,
+    /// 4, …, 16 steps (doubled after each consecutive refusal)
+    #[arg(long, conflicts_with = "no_inertia")]
+    pub exact_backoff: bool,
     /// displacement limit factor: no vertex moves more than F · r · λ_min(Ī) per Newton step (the design's 1)
     #[arg(long, default_value_t = 1.0, value_name = "F", value_parser = positive_finite, allow_hyphen_values = true)]
     pub step_factor: f64,
@@ -80,6 +84,7 @@ impl SolverArgs {
             crossings: self.crossings.unwrap_or_default(),
             trust_region: self.trust_region,
             inertia: !self.no_inertia,
+            exact_backoff: self.exact_backoff,
             step_factor: self.step_factor,
             ..Default::default()
         }
