@@ -13,7 +13,7 @@ use hylc::pattern::Pattern;
 use hylc::rod::bend_twist::{bend_twist_value, bend_twist_vgh, BendTwistParams, StencilFrames};
 use hylc::rod::frame::reference_twist_raw;
 use hylc::rod::stretch::stretch_vgh;
-use hylc::rod::YarnMaterial;
+use hylc::rod::{BendingForm, YarnMaterial};
 use hylc::tile::{Terms, Tile, Want};
 use nalgebra::Vector3;
 use std::hint::black_box;
@@ -56,6 +56,7 @@ fn bench_kernels(c: &mut Criterion) {
         voronoi_length: 1.2 * R,
         bend: m.bend_stiffness(),
         twist: m.twist_stiffness(),
+        form: BendingForm::Tan,
     };
     let x1 = Vector3::zeros();
     let x = [

@@ -5,7 +5,7 @@
 use hylc::rod::bend_twist::{bend_twist_value, bend_twist_vgh, BendTwistParams, StencilFrames};
 use hylc::rod::frame::{continuous_twist, reference_twist_raw};
 use hylc::rod::stretch::stretch_vgh;
-use hylc::rod::YarnMaterial;
+use hylc::rod::{BendingForm, YarnMaterial};
 use nalgebra::{Rotation3, Unit, Vector3};
 use proptest::prelude::*;
 use std::f64::consts::PI;
@@ -51,26 +51,34 @@ fn stencil() -> impl Strategy<Value = Stencil> {
         (-PI..PI, -PI..PI),
         (-PI..PI, -PI..PI),
         (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64),
+        prop::bool::ANY,
     )
         .prop_filter("not folded", |(_, a, b, ..)| a.dot(b) > -0.95)
-        .prop_map(|(x1, t0, t1, l0, l1, (a0, a1), (th0, th1), (k1, k2, m))| {
-            let u0 = perp(&t0, a0);
-            let u1 = perp(&t1, a1);
-            let twist = reference_twist_raw(&t0, &u0, &t1, &u1);
-            let mat = YarnMaterial::default();
-            Stencil {
-                x: [x1 - t0 * l0, x1, x1 + t1 * l1],
-                theta: [th0, th1],
-                frames: StencilFrames::new(t0, u0, t1, u1, twist),
-                params: BendTwistParams {
-                    rest_curvature: [k1, k2],
-                    rest_twist: m,
-                    voronoi_length: 0.5 * (l0 + l1),
-                    bend: mat.bend_stiffness(),
-                    twist: mat.twist_stiffness(),
-                },
-            }
-        })
+        .prop_map(
+            |(x1, t0, t1, l0, l1, (a0, a1), (th0, th1), (k1, k2, m), sin)| {
+                let u0 = perp(&t0, a0);
+                let u1 = perp(&t1, a1);
+                let twist = reference_twist_raw(&t0, &u0, &t1, &u1);
+                let mat = YarnMaterial::default();
+                Stencil {
+                    x: [x1 - t0 * l0, x1, x1 + t1 * l1],
+                    theta: [th0, th1],
+                    frames: StencilFrames::new(t0, u0, t1, u1, twist),
+                    params: BendTwistParams {
+                        rest_curvature: [k1, k2],
+                        rest_twist: m,
+                        voronoi_length: 0.5 * (l0 + l1),
+                        bend: mat.bend_stiffness(),
+                        twist: mat.twist_stiffness(),
+                        form: if sin {
+                            BendingForm::Sin
+                        } else {
+                            BendingForm::Tan
+                        },
+                    },
+                }
+            },
+        )
 }
 
 /// A perturbation of the positions (the stored frames stay) so that transport is exercised.

@@ -5,7 +5,7 @@
 use hylc::contact::pair::PairKernel;
 use hylc::material::synthetic::default_material;
 use hylc::rod::checked::{bend_twist_checked, stretch_checked};
-use hylc::rod::{BendTwistParams, StencilFrames};
+use hylc::rod::{BendTwistParams, BendingForm, StencilFrames};
 use hylc::shell::{RestTriangle, StrainChain};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
@@ -180,6 +180,11 @@ fn rod_stencils_are_finite_or_an_error_at_extreme_inputs() {
             voronoi_length: extreme(&mut rng, r).abs(),
             bend: extreme(&mut rng, 1e-6).abs(),
             twist: extreme(&mut rng, 1e-6).abs(),
+            form: if rng.random_bool(0.5) {
+                BendingForm::Sin
+            } else {
+                BendingForm::Tan
+            },
         };
         let theta = [extreme(&mut rng, 1.0), extreme(&mut rng, 1.0)];
         match bend_twist_checked(&x, theta, &fr, &p) {

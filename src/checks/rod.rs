@@ -19,7 +19,7 @@ use crate::rod::bend_twist::{
 };
 use crate::rod::frame::reference_twist_raw;
 use crate::rod::stretch::{stretch_reference, stretch_value, stretch_vgh};
-use crate::rod::YarnMaterial;
+use crate::rod::{BendingForm, YarnMaterial};
 use nalgebra::{DMatrix, DVector, Vector3};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -126,10 +126,10 @@ impl Differentiable for StretchCheck {
 }
 
 /// Bending+twisting stencil: inputs (x⁰, x¹, x², θ⁰, θ¹); parameters (t⁰, u⁰, t¹, u¹ of the stored state, stored
-/// reference twist, κ̄₁, κ̄₂, m̄, l̄, B, GJ).
-pub struct BendTwistCheck;
+/// reference twist, κ̄₁, κ̄₂, m̄, l̄, B, GJ), with the curvature in the given [`BendingForm`].
+pub struct BendTwistCheck(pub BendingForm);
 
-fn parse(x: &[f64]) -> (StencilFrames, BendTwistParams) {
+fn parse(x: &[f64], form: BendingForm) -> (StencilFrames, BendTwistParams) {
     let v = |k: usize| Vector3::new(x[k], x[k + 1], x[k + 2]);
     let fr = StencilFrames::new(v(11), v(14), v(17), v(20), x[23]);
     let p = BendTwistParams {
@@ -138,6 +138,7 @@ fn parse(x: &[f64]) -> (StencilFrames, BendTwistParams) {
         voronoi_length: x[27],
         bend: x[28],
         twist: x[29],
+        form,
     };
     (fr, p)
 }
@@ -149,7 +150,10 @@ fn shortest_edge(x: &[f64]) -> f64 {
 
 impl Differentiable for BendTwistCheck {
     fn name(&self) -> String {
-        "rod-bend-twist".into()
+        match self.0 {
+            BendingForm::Tan => "rod-bend-twist".into(),
+            BendingForm::Sin => "rod-bend-twist-sin".into(),
+        }
     }
     fn dim(&self) -> usize {
         11
@@ -158,7 +162,7 @@ impl Differentiable for BendTwistCheck {
         19
     }
     fn scales_at(&self, x: &[f64]) -> Scales {
-        let (_, p) = parse(x);
+        let (_, p) = parse(x, self.0);
         let k = (p.bend + p.twist) / p.voronoi_length;
         let l = shortest_edge(x);
         Scales {
@@ -187,11 +191,11 @@ impl Differentiable for BendTwistCheck {
     }
     fn reference<D: Real>(&self, x: &[D]) -> D {
         let xf: Vec<f64> = x.iter().map(|v| v.re()).collect();
-        let (fr, p) = parse(&xf);
+        let (fr, p) = parse(&xf, self.0);
         bend_twist_reference(&x[..11], &fr, &p)
     }
     fn fast(&self, x: &[f64]) -> Vgh {
-        let (fr, p) = parse(x);
+        let (fr, p) = parse(x, self.0);
         let (pos, th) = unpack(x);
         let (v, g, h) = bend_twist_vgh(&pos, th, &fr, &p);
         Vgh {
@@ -201,7 +205,7 @@ impl Differentiable for BendTwistCheck {
         }
     }
     fn fast_value(&self, x: &[f64]) -> f64 {
-        let (fr, p) = parse(x);
+        let (fr, p) = parse(x, self.0);
         let (pos, th) = unpack(x);
         bend_twist_value(&pos, th, &fr, &p)
     }
@@ -270,5 +274,9 @@ impl Differentiable for BendTwistCheck {
 
 /// The rod rows of the harness.
 pub fn diff_checks() -> Vec<Box<dyn Check>> {
-    vec![Box::new(StretchCheck), Box::new(BendTwistCheck)]
+    vec![
+        Box::new(StretchCheck),
+        Box::new(BendTwistCheck(BendingForm::Tan)),
+        Box::new(BendTwistCheck(BendingForm::Sin)),
+    ]
 }

@@ -223,10 +223,25 @@ pub(crate) fn reference_energy<D: Real>(
 /// The whole-tile rows: built from the embedded generated patterns (no external data needed).
 pub fn diff_checks() -> Vec<Box<dyn Check>> {
     let m = YarnMaterial::default();
-    crate::generate::harness_patterns()
+    let patterns = crate::generate::harness_patterns();
+    // the bending-discretisation variant (issue 22) on the first pattern: the rest-curvature conversion and
+    // the form's kernels assembled into a tile
+    let sin = YarnMaterial {
+        bending: crate::rod::BendingForm::Sin,
+        ..m.clone()
+    };
+    let variant = patterns.first().map(|(name, p)| {
+        Box::new(TileCheck::new(
+            &format!("tile[{name}; sin bending]"),
+            p.clone(),
+            &sin,
+        )) as Box<dyn Check>
+    });
+    patterns
         .into_iter()
         .map(|(name, p)| {
             Box::new(TileCheck::new(&format!("tile[{name}]"), p, &m)) as Box<dyn Check>
         })
+        .chain(variant)
         .collect()
 }

@@ -12,8 +12,8 @@
 //! U⁰ = P(t⁰→t¹) u⁰ = u⁰ − (u⁰·t¹)/(1 + t⁰·t¹) (t⁰ + t¹).
 
 use super::frame::{
-    continuous_twist, curvature_binormal, curvature_binormal_jet, edge_frame, reference_twist_raw,
-    transport,
+    continuous_twist, curvature_binormal_in, curvature_binormal_jet, edge_frame,
+    reference_twist_raw, transport, BendingForm,
 };
 use super::generic::transport_generic;
 use super::jet::{Jet, VJet};
@@ -67,6 +67,8 @@ pub struct BendTwistParams {
     pub bend: f64,
     /// Twisting stiffness GJ.
     pub twist: f64,
+    /// How the curvature measures the turning angle (`Tan`: the design's 2 tan(φ/2)).
+    pub form: BendingForm,
 }
 
 /// Current kinematic quantities of a stencil (value level).
@@ -89,8 +91,19 @@ fn material_frame(u: &Vector3<f64>, v: &Vector3<f64>, theta: f64) -> (Vector3<f6
     (u * c + v * s, v * c - u * s)
 }
 
-/// Curvature, reference twist and twist of a stencil at positions `x` and angles `theta`.
+/// Curvature (in the `Tan` form, the form rest curvatures are stored in), reference twist and twist of a stencil
+/// at positions `x` and angles `theta`.
 pub fn kinematics(x: &[Vector3<f64>; 3], theta: [f64; 2], fr: &StencilFrames) -> StencilKinematics {
+    kinematics_in(x, theta, fr, BendingForm::Tan)
+}
+
+/// [`kinematics`] with the curvature in the given [`BendingForm`].
+pub fn kinematics_in(
+    x: &[Vector3<f64>; 3],
+    theta: [f64; 2],
+    fr: &StencilFrames,
+    form: BendingForm,
+) -> StencilKinematics {
     let e0 = x[1] - x[0];
     let e1 = x[2] - x[1];
     let t0 = e0.normalize();
@@ -99,7 +112,7 @@ pub fn kinematics(x: &[Vector3<f64>; 3], theta: [f64; 2], fr: &StencilFrames) ->
     let u1 = transport(&fr.t1, &t1, &fr.u1);
     let (m10, m20) = material_frame(&u0, &t0.cross(&u0), theta[0]);
     let (m11, m21) = material_frame(&u1, &t1.cross(&u1), theta[1]);
-    let kb = curvature_binormal(&e0, &e1);
+    let kb = curvature_binormal_in(&e0, &e1, form);
     let curvature = [0.5 * kb.dot(&(m20 + m21)), -0.5 * kb.dot(&(m10 + m11))];
     let raw = reference_twist_raw(&t0, &u0, &t1, &u1);
     let ref_twist = continuous_twist(fr.twist, fr.twist_raw, raw);
@@ -119,7 +132,7 @@ pub fn bend_twist_value(
     fr: &StencilFrames,
     p: &BendTwistParams,
 ) -> f64 {
-    let k = kinematics(x, theta, fr);
+    let k = kinematics_in(x, theta, fr, p.form);
     energy_of(&k, p)
 }
 
@@ -130,7 +143,7 @@ pub fn bend_twist_parts(
     fr: &StencilFrames,
     p: &BendTwistParams,
 ) -> [f64; 2] {
-    parts_of(&kinematics(x, theta, fr), p)
+    parts_of(&kinematics_in(x, theta, fr, p.form), p)
 }
 
 fn energy_of(k: &StencilKinematics, p: &BendTwistParams) -> f64 {
@@ -190,6 +203,7 @@ fn kinematics_jets(
     x: &[Vector3<f64>; 3],
     theta: [f64; 2],
     fr: &StencilFrames,
+    form: BendingForm,
 ) -> (Jet<8>, Jet<8>, Jet<8>) {
     let e0 = x[1] - x[0];
     let e1 = x[2] - x[1];
@@ -205,7 +219,7 @@ fn kinematics_jets(
     let v1 = VJet::<8>::embed(&f1.v, c1);
     let (m10, m20) = material_frame_jet(&u0, &v0, theta[0], 6);
     let (m11, m21) = material_frame_jet(&u1, &v1, theta[1], 7);
-    let kb = VJet::<8>::embed(&curvature_binormal_jet(&e0, &e1), [0, 1, 2, 3, 4, 5]);
+    let kb = VJet::<8>::embed(&curvature_binormal_jet(&e0, &e1, form), [0, 1, 2, 3, 4, 5]);
     let k1 = kb.dot(&m20.add(&m21)).scale(0.5);
     let k2 = kb.dot(&m10.add(&m11)).scale(-0.5);
 
@@ -241,7 +255,7 @@ pub fn bend_twist_parts_vgh(
     fr: &StencilFrames,
     p: &BendTwistParams,
 ) -> ([f64; 2], SVector<f64, 11>, SMatrix<f64, 11, 11>) {
-    let (k1, k2, m) = kinematics_jets(x, theta, fr);
+    let (k1, k2, m) = kinematics_jets(x, theta, fr, p.form);
     let iv = 1.0 / p.voronoi_length;
     let mut d1 = k1;
     d1.v -= p.rest_curvature[0];
@@ -292,10 +306,13 @@ pub fn bend_twist_reference<D: Real>(x: &[D], fr: &StencilFrames, p: &BendTwistP
     };
     let (m10, m20) = frame(&u0, &v0, &th0);
     let (m11, m21) = frame(&u1, &v1, &th1);
-    let kb = g::scale(
-        &g::cross(&e0, &e1),
-        &(D::from(2.0) / (l0 * l1 + g::dot(&e0, &e1))),
-    );
+    let ll = l0 * l1;
+    let d = ll.clone() + g::dot(&e0, &e1);
+    let factor = match p.form {
+        BendingForm::Tan => D::from(2.0) / d,
+        BendingForm::Sin => D::from(2.0) / (ll * d * 2.0).sqrt(),
+    };
+    let kb = g::scale(&g::cross(&e0, &e1), &factor);
     let k1 = g::dot(&kb, &g::add(&m20, &m21)) * 0.5;
     let k2 = g::dot(&kb, &g::add(&m10, &m11)) * (-0.5);
     let pu0 = transport_generic(&t0, &t1, &u0);

@@ -1,7 +1,7 @@
 //! Frames, parallel transport, curvature binormal and reference twist (`02-yarn-model.md`, "Discrete elastic
 //! rods"), as plain values and as hand-differentiated primitives (value, Jacobian, Hessian).
 
-use super::jet::VJet;
+use super::jet::{Jet, VJet};
 use nalgebra::{Matrix3, Vector3};
 
 /// Parallel transport P(a→b) x of a vector x from unit tangent a to unit tangent b: the rotation about a × b by
@@ -13,9 +13,49 @@ pub fn transport(a: &Vector3<f64>, b: &Vector3<f64>, x: &Vector3<f64>) -> Vector
     x * c + k.cross(x) + k * (k.dot(x) / (1.0 + c))
 }
 
-/// Curvature binormal κb = 2 e⁰ × e¹ / (|e⁰||e¹| + e⁰·e¹).
+/// How the discrete curvature measures the turning angle φ between two edges (`02-yarn-model.md`, "Discrete
+/// elastic rods"): the curvature binormal is κb = k(φ) b with b the unit binormal e⁰ × e¹ / |e⁰ × e¹|.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BendingForm {
+    /// k(φ) = 2 tan(φ/2) (Bergou et al.): κb = 2 e⁰ × e¹ / (|e⁰||e¹| + e⁰·e¹); the design's form.
+    #[default]
+    Tan,
+    /// k(φ) = 2 sin(φ/2): κb = 2 e⁰ × e¹ / √(2 |e⁰||e¹| (|e⁰||e¹| + e⁰·e¹)), bounded as φ → π (issue 22's
+    /// bending-discretisation variant).
+    Sin,
+}
+
+impl BendingForm {
+    /// The factor k_form(φ) / (2 tan(φ/2)) at the angle φ whose `Tan` measure is k = 2 tan(φ/2): 1 for `Tan`,
+    /// cos(φ/2) = 1/√(1 + k²/4) for `Sin`. Rest curvatures, stored in the `Tan` form, carry over to this form by
+    /// this factor (the curvature binormal of either form is the other's times a scalar, and so are its
+    /// material-frame components).
+    pub fn factor_from_tan(self, k: f64) -> f64 {
+        match self {
+            BendingForm::Tan => 1.0,
+            BendingForm::Sin => 1.0 / (1.0 + 0.25 * k * k).sqrt(),
+        }
+    }
+}
+
+/// Curvature binormal κb = 2 e⁰ × e¹ / (|e⁰||e¹| + e⁰·e¹) (the `Tan` form).
 pub fn curvature_binormal(e0: &Vector3<f64>, e1: &Vector3<f64>) -> Vector3<f64> {
-    e0.cross(e1) * (2.0 / (e0.norm() * e1.norm() + e0.dot(e1)))
+    curvature_binormal_in(e0, e1, BendingForm::Tan)
+}
+
+/// Curvature binormal in the given [`BendingForm`].
+pub fn curvature_binormal_in(
+    e0: &Vector3<f64>,
+    e1: &Vector3<f64>,
+    form: BendingForm,
+) -> Vector3<f64> {
+    let ll = e0.norm() * e1.norm();
+    let d = ll + e0.dot(e1);
+    match form {
+        BendingForm::Tan => e0.cross(e1) * (2.0 / d),
+        BendingForm::Sin => e0.cross(e1) * (2.0 / (2.0 * ll * d).sqrt()),
+    }
 }
 
 /// The reference twist as a raw angle in (−π, π]: the signed angle, about t¹, from P(t⁰→t¹) u⁰ to u¹.
@@ -140,8 +180,9 @@ pub fn edge_frame(e: &Vector3<f64>, a: &Vector3<f64>, ubar: &Vector3<f64>) -> Ed
 /// Curvature binormal κb = 2 n / D with n = e⁰ × e¹, D = |e⁰||e¹| + e⁰·e¹, with its Jacobian and Hessians over
 /// the six variables (e⁰, e¹). ∂n/∂e⁰ = −[e¹]×, ∂n/∂e¹ = [e⁰]×, ∂²nᵢ/∂e⁰ₐ∂e¹_b = εᵢₐ_b;
 /// ∇D = (|e¹| t⁰ + e¹, |e⁰| t¹ + e⁰), ∂²D/∂e⁰² = |e¹| 𝑃⁰/|e⁰|, ∂²D/∂e¹² = |e⁰| 𝑃¹/|e¹|, ∂²D/∂e⁰∂e¹ = t⁰t¹ᵀ + I;
-/// then the quotient rule.
-pub fn curvature_binormal_jet(e0: &Vector3<f64>, e1: &Vector3<f64>) -> VJet<6> {
+/// then the quotient rule. In the `Sin` form the factor 2/D becomes √2 P^(−1/2) with P = |e⁰||e¹| D, whose
+/// derivatives follow from those of |e⁰|, |e¹| and D by the product and power rules.
+pub fn curvature_binormal_jet(e0: &Vector3<f64>, e1: &Vector3<f64>, form: BendingForm) -> VJet<6> {
     use nalgebra::{SMatrix, SVector};
     let (l0, l1) = (e0.norm(), e1.norm());
     let (t0, t1) = (e0 / l0, e1 / l1);
@@ -164,10 +205,23 @@ pub fn curvature_binormal_jet(e0: &Vector3<f64>, e1: &Vector3<f64>) -> VJet<6> {
     let off = t0 * t1.transpose() + i3;
     hd.fixed_view_mut::<3, 3>(0, 3).copy_from(&off);
     hd.fixed_view_mut::<3, 3>(3, 0).copy_from(&off.transpose());
-    // q = 1/D
-    let q = 1.0 / d;
-    let gq = -gd * (q * q);
-    let hq = -hd * (q * q) + gd * gd.transpose() * (2.0 * q * q * q);
+    // the factor q with κb = n q: 2/D (Tan) or √2 (|e⁰||e¹| D)^(−1/2) (Sin)
+    let dj = Jet::<6> { v: d, g: gd, h: hd };
+    let qj = match form {
+        BendingForm::Tan => dj.recip().scale(2.0),
+        BendingForm::Sin => {
+            let norm_jet = |t: &Vector3<f64>, l: f64, at: usize| {
+                let mut j = Jet::<6>::constant(l);
+                j.g.fixed_rows_mut::<3>(at).copy_from(t);
+                j.h.fixed_view_mut::<3, 3>(at, at)
+                    .copy_from(&((i3 - t * t.transpose()) / l));
+                j
+            };
+            let p = norm_jet(&t0, l0, 0).mul(&norm_jet(&t1, l1, 3)).mul(&dj);
+            p.powf(-0.5).scale(std::f64::consts::SQRT_2)
+        }
+    };
+    let (q, gq, hq) = (qj.v, qj.g, qj.h);
     let mut j = SMatrix::<f64, 3, 6>::zeros();
     let mut h = [SMatrix::<f64, 6, 6>::zeros(); 3];
     for i in 0..3 {
@@ -179,12 +233,33 @@ pub fn curvature_binormal_jet(e0: &Vector3<f64>, e1: &Vector3<f64>) -> VJet<6> {
         hn[(b, 3 + a)] = -1.0;
         hn[(3 + b, a)] = 1.0;
         hn[(3 + a, b)] = -1.0;
-        j.set_row(i, &((gni * q + gq * n[i]) * 2.0).transpose());
-        h[i] = (hn * q + gni * gq.transpose() + gq * gni.transpose() + hq * n[i]) * 2.0;
+        j.set_row(i, &(gni * q + gq * n[i]).transpose());
+        h[i] = hn * q + gni * gq.transpose() + gq * gni.transpose() + hq * n[i];
     }
-    VJet {
-        v: n * (2.0 * q),
-        j,
-        h,
+    VJet { v: n * q, j, h }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// In-plane edges turning by φ: |κb| is 2 tan(φ/2) in the `Tan` form and 2 sin(φ/2) in the `Sin` form, along
+    /// the binormal, whatever the edge lengths; `factor_from_tan` maps one measure of an angle to the other.
+    #[test]
+    fn the_two_forms_measure_the_turning_angle() {
+        for (phi, l0, l1) in [(0.3f64, 1.0, 2.0), (1.2, 0.5, 0.7), (2.9, 3.0, 1.0)] {
+            let e0 = Vector3::new(l0, 0.0, 0.0);
+            let e1 = Vector3::new(phi.cos(), phi.sin(), 0.0) * l1;
+            let kt = curvature_binormal_in(&e0, &e1, BendingForm::Tan);
+            let ks = curvature_binormal_in(&e0, &e1, BendingForm::Sin);
+            let tan = 2.0 * (phi / 2.0).tan();
+            let sin = 2.0 * (phi / 2.0).sin();
+            assert!((kt - Vector3::new(0.0, 0.0, tan)).norm() < 1e-12 * tan);
+            assert!((ks - Vector3::new(0.0, 0.0, sin)).norm() < 1e-12);
+            assert!((BendingForm::Sin.factor_from_tan(tan) * tan - sin).abs() < 1e-12);
+            assert_eq!(BendingForm::Tan.factor_from_tan(tan), 1.0);
+            let jet = curvature_binormal_jet(&e0, &e1, BendingForm::Sin);
+            assert!((jet.v - ks).norm() < 1e-14);
+        }
     }
 }

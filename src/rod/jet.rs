@@ -77,6 +77,18 @@ impl<const N: usize> Jet<N> {
         }
     }
 
+    /// Power aᵖ (a > 0): gradient p aᵖ⁻¹ a', Hessian p aᵖ⁻¹ a'' + p (p − 1) aᵖ⁻² a' a'ᵀ.
+    pub fn powf(&self, p: f64) -> Self {
+        let f = self.v.powf(p);
+        let f1 = p * f / self.v;
+        let f2 = (p - 1.0) * f1 / self.v;
+        Jet {
+            v: f,
+            g: self.g * f1,
+            h: self.h * f1 + self.g * self.g.transpose() * f2,
+        }
+    }
+
     /// Half-square ½a² (used by the quadratic energies).
     pub fn half_square(&self) -> Self {
         Jet {

@@ -7,6 +7,7 @@
 //! keys refused. `hylc yarn` prints the defaults in this form. Errors name the file and the key at fault on one
 //! line ([`YarnFileError`]).
 
+use super::frame::BendingForm;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -38,6 +39,11 @@ pub struct YarnMaterial {
     pub contact_exclusion: usize,
     /// Contact radius factor f: the contact distance is 2 f r (1: the yarns touch at their surfaces).
     pub contact_radius_factor: f64,
+    /// How the discrete curvature measures a turning angle φ: `"tan"` (2 tan(φ/2), the design's form) or `"sin"`
+    /// (2 sin(φ/2)); rest curvatures, stored in the `tan` form, keep their angles. The one key added after the
+    /// format was fixed: a file without it means `"tan"`, the form every earlier file was made with.
+    #[serde(default)]
+    pub bending: BendingForm,
 }
 
 impl Default for YarnMaterial {
@@ -52,6 +58,7 @@ impl Default for YarnMaterial {
             contact_quadrature: 4,
             contact_exclusion: 3,
             contact_radius_factor: 1.0,
+            bending: BendingForm::Tan,
         }
     }
 }
@@ -224,6 +231,9 @@ impl YarnMaterial {
         if self.contact_radius_factor != 1.0 {
             s += &format!(" contact_radius_factor: {:?}", self.contact_radius_factor);
         }
+        if self.bending != BendingForm::Tan {
+            s += &format!(" bending: {:?}", self.bending);
+        }
         s
     }
 }
@@ -267,6 +277,25 @@ mod tests {
             "{e}"
         );
         assert!(!e.contains('\n'), "{e}");
+    }
+
+    #[test]
+    fn the_bending_key_defaults_to_tan_and_names_itself_when_wrong() {
+        let mut v = serde_json::to_value(YarnMaterial::default()).unwrap();
+        assert_eq!(v["bending"], serde_json::json!("tan"));
+        v.as_object_mut().unwrap().remove("bending");
+        assert_eq!(parse(&v.to_string()).unwrap(), YarnMaterial::default());
+        v["bending"] = serde_json::json!("sin");
+        assert_eq!(parse(&v.to_string()).unwrap().bending, BendingForm::Sin);
+        v["bending"] = serde_json::json!("cos");
+        let e = parse(&v.to_string()).unwrap_err().to_string();
+        assert!(e.starts_with("yarn.json: ") && e.contains("`cos`"), "{e}");
+        assert!(!e.contains('\n'), "{e}");
+        let sin = YarnMaterial {
+            bending: BendingForm::Sin,
+            ..Default::default()
+        };
+        assert_ne!(sin.hash_text(), YarnMaterial::default().hash_text());
     }
 
     #[test]

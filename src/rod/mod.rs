@@ -11,5 +11,6 @@ pub mod state;
 pub mod stretch;
 
 pub use bend_twist::{BendTwistParams, StencilFrames};
+pub use frame::BendingForm;
 pub use material::{YarnFileError, YarnMaterial, MAX_CONTACT_QUADRATURE};
 pub use state::{raw_reference_twists, set_rest_to_current, RodState, RodTopology, StencilDofs};

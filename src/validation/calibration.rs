@@ -67,6 +67,7 @@ pub fn gradient_parts(
         contact_quadrature: form.quadrature,
         contact_exclusion: form.exclusion,
         contact_radius_factor: form.radius_factor,
+        bending: crate::rod::BendingForm::Tan,
     };
     let state = RodState::from_pattern(pattern);
     let mut tile = Tile::new(pattern, &unit);
