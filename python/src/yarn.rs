@@ -28,8 +28,13 @@ pub fn yarn_of(arg: Option<&Bound<'_, PyAny>>) -> HyResult<YarnMaterial> {
             serde_json::json!(i)
         } else if let Ok(x) = v.extract::<f64>() {
             serde_json::json!(x)
+        } else if let Ok(t) = v.extract::<String>() {
+            // the one text-valued key, `bending` ("tan" or "sin"); the yarn file's parser checks the value
+            serde_json::json!(t)
         } else {
-            return Err(HyError::value(format!("yarn: {key}: expected a number")));
+            return Err(HyError::value(format!(
+                "yarn: {key}: expected a number (or a string for `bending`)"
+            )));
         };
         map.insert(key, json);
     }

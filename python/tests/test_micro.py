@@ -178,6 +178,13 @@ def test_yarn_round_trip(tmp_path, cli):
     hylc.save_yarn(y, path)
     assert hylc.load_yarn(path) == y
     assert cli("yarn", path).stdout.strip() == path.read_text().strip()
+    # the text-valued key of the bending-discretisation variant
+    assert y["bending"] == "tan"
+    y["bending"] = "sin"
+    hylc.save_yarn(y, path)
+    assert hylc.load_yarn(path)["bending"] == "sin"
+    with pytest.raises(ValueError, match="cos"):
+        hylc.save_yarn(dict(y, bending="cos"), path)
 
 
 def test_the_gil_is_released_during_a_batch():
