@@ -12,8 +12,8 @@
 //! U⁰ = P(t⁰→t¹) u⁰ = u⁰ − (u⁰·t¹)/(1 + t⁰·t¹) (t⁰ + t¹).
 
 use super::frame::{
-    continuous_twist, curvature_binormal_in, curvature_binormal_jet, edge_frame,
-    reference_twist_raw, transport, BendingForm,
+    continuous_twist, curvature_binormal, curvature_binormal_jet, edge_frame, reference_twist_raw,
+    transport, BendingForm,
 };
 use super::generic::transport_generic;
 use super::jet::{Jet, VJet};
@@ -112,7 +112,7 @@ pub fn kinematics_in(
     let u1 = transport(&fr.t1, &t1, &fr.u1);
     let (m10, m20) = material_frame(&u0, &t0.cross(&u0), theta[0]);
     let (m11, m21) = material_frame(&u1, &t1.cross(&u1), theta[1]);
-    let kb = curvature_binormal_in(&e0, &e1, form);
+    let kb = curvature_binormal(&e0, &e1, form);
     let curvature = [0.5 * kb.dot(&(m20 + m21)), -0.5 * kb.dot(&(m10 + m11))];
     let raw = reference_twist_raw(&t0, &u0, &t1, &u1);
     let ref_twist = continuous_twist(fr.twist, fr.twist_raw, raw);

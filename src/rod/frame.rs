@@ -37,19 +37,25 @@ impl BendingForm {
             BendingForm::Sin => 1.0 / (1.0 + 0.25 * k * k).sqrt(),
         }
     }
+
+    /// A stencil's rest curvature (κ̄₁, κ̄₂) in this form, from the one stored in the `Tan` form with rest twist m̄:
+    /// the same rest angle, so [`factor_from_tan`](Self::factor_from_tan) at |κb̄| = |κ̄| / |cos(m̄/2)| (the
+    /// binormal is fixed by the transport between the edges, so its angles to the two material frames differ by
+    /// the twist m̄). The stored values unchanged for `Tan`.
+    pub fn rest_curvature_from_tan(self, stored: [f64; 2], rest_twist: f64) -> [f64; 2] {
+        match self {
+            BendingForm::Tan => stored,
+            BendingForm::Sin => {
+                let [k1, k2] = stored;
+                let c = self.factor_from_tan(k1.hypot(k2) / (0.5 * rest_twist).cos().abs());
+                [k1 * c, k2 * c]
+            }
+        }
+    }
 }
 
-/// Curvature binormal κb = 2 e⁰ × e¹ / (|e⁰||e¹| + e⁰·e¹) (the `Tan` form).
-pub fn curvature_binormal(e0: &Vector3<f64>, e1: &Vector3<f64>) -> Vector3<f64> {
-    curvature_binormal_in(e0, e1, BendingForm::Tan)
-}
-
-/// Curvature binormal in the given [`BendingForm`].
-pub fn curvature_binormal_in(
-    e0: &Vector3<f64>,
-    e1: &Vector3<f64>,
-    form: BendingForm,
-) -> Vector3<f64> {
+/// Curvature binormal in the given [`BendingForm`]: κb = 2 e⁰ × e¹ / (|e⁰||e¹| + e⁰·e¹) for `Tan`.
+pub fn curvature_binormal(e0: &Vector3<f64>, e1: &Vector3<f64>, form: BendingForm) -> Vector3<f64> {
     let ll = e0.norm() * e1.norm();
     let d = ll + e0.dot(e1);
     match form {
@@ -250,8 +256,8 @@ mod tests {
         for (phi, l0, l1) in [(0.3f64, 1.0, 2.0), (1.2, 0.5, 0.7), (2.9, 3.0, 1.0)] {
             let e0 = Vector3::new(l0, 0.0, 0.0);
             let e1 = Vector3::new(phi.cos(), phi.sin(), 0.0) * l1;
-            let kt = curvature_binormal_in(&e0, &e1, BendingForm::Tan);
-            let ks = curvature_binormal_in(&e0, &e1, BendingForm::Sin);
+            let kt = curvature_binormal(&e0, &e1, BendingForm::Tan);
+            let ks = curvature_binormal(&e0, &e1, BendingForm::Sin);
             let tan = 2.0 * (phi / 2.0).tan();
             let sin = 2.0 * (phi / 2.0).sin();
             assert!((kt - Vector3::new(0.0, 0.0, tan)).norm() < 1e-12 * tan);

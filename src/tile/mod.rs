@@ -213,15 +213,12 @@ impl<'a> Tile<'a> {
     }
 
     pub(crate) fn bend_params(&self, i: usize, terms: &Terms) -> BendTwistParams {
-        // rest curvatures are stored in the `Tan` form: |κ̄| = |κb̄| |cos(m̄/2)| (the binormal is fixed by the
-        // transport between the edges, so its angles to the two material frames differ by the twist m̄)
         let form = self.material.bending;
-        let [k1, k2] = self.pattern.rest_curvature[i];
-        let kb = k1.hypot(k2) / (0.5 * self.pattern.rest_twist[i]).cos().abs();
-        let c = form.factor_from_tan(kb);
+        let rest_twist = self.pattern.rest_twist[i];
         BendTwistParams {
-            rest_curvature: [k1 * c, k2 * c],
-            rest_twist: self.pattern.rest_twist[i],
+            rest_curvature: form
+                .rest_curvature_from_tan(self.pattern.rest_curvature[i], rest_twist),
+            rest_twist,
             voronoi_length: self.voronoi[i],
             bend: self.material.bend_stiffness() * terms.bend,
             twist: self.material.twist_stiffness() * terms.twist,
