@@ -117,3 +117,39 @@ fn exact_backoff_changes_the_path_not_the_equilibrium() {
     assert!(json.contains("\"exact_backoff\":true"), "{json}");
     assert_eq!(serde_json::from_str::<SolverOptions>(&json).unwrap(), on);
 }
+
+/// `SolverOptions::interpolating_search`: on the compressed, bent plain weave solved cold (a solve that
+/// backtracks) the interpolated trial steps change the path but not the equilibrium (Ψ̄ to 1e-8); the option is
+/// off by default and written to the settings JSON only while on.
+#[test]
+fn interpolating_search_changes_the_path_not_the_equilibrium() {
+    let z = MacroStrain::new(-0.4, 0.0, 0.0, 0.0, 150.0);
+    let factor = problem(true).solve(&z, None).unwrap();
+    let interpolated = MicroProblem::new(
+        default_pattern("plain").unwrap(),
+        &YarnMaterial::default(),
+        SolverOptions {
+            interpolating_search: true,
+            ..Default::default()
+        },
+    )
+    .solve(&z, None)
+    .unwrap();
+    same_equilibrium(&z, &factor, &interpolated);
+    assert_ne!(
+        factor.steps, interpolated.steps,
+        "the interpolated trial steps changed nothing"
+    );
+    let off = SolverOptions::default();
+    assert!(!off.interpolating_search);
+    assert!(!serde_json::to_string(&off)
+        .unwrap()
+        .contains("interpolating_search"));
+    let on = SolverOptions {
+        interpolating_search: true,
+        ..Default::default()
+    };
+    let json = serde_json::to_string(&on).unwrap();
+    assert!(json.contains("\"interpolating_search\":true"), "{json}");
+    assert_eq!(serde_json::from_str::<SolverOptions>(&json).unwrap(), on);
+}

@@ -92,6 +92,14 @@ pub struct SolverOptions {
     /// floor. Not written to the settings JSON while off.
     #[serde(default, skip_serializing_if = "is_false")]
     pub exact_backoff: bool,
+    /// The line search's trial steps by safeguarded quadratic interpolation (`03-homogenization.md`, section 4,
+    /// step 5, with the step length chosen as in a standard interpolating backtracking): after a refused trial t
+    /// with energy E(t), the next is the minimiser of the parabola through E(0), the slope gᵀδ at 0 and E(t),
+    /// kept within [0.1 t, 0.5 t] (0.1 t when E(t) is not finite or the trial crossed yarns). Acceptance is
+    /// unchanged (any lower energy). Off (the default): trial steps factorⁱ ([`SolverOptions::backtracking`]).
+    /// Not written to the settings JSON while off.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub interpolating_search: bool,
     /// Emit one `tracing` event (info level) per Newton step: energy, ‖g‖∞, decrement, μ, step length (`hylc
     /// solve --trace` prints them to stderr).
     pub trace: bool,
@@ -115,6 +123,7 @@ impl Default for SolverOptions {
             trust_region: false,
             inertia: true,
             exact_backoff: false,
+            interpolating_search: false,
             trace: false,
         }
     }

@@ -534,8 +534,9 @@ impl MicroProblem {
             } else {
                 // 4. back to tile dofs, displacement limit
                 let dmax_now = run.limit_step(&mut delta);
-                // 5. line search
-                (run.line_search(&mut state, &delta, energy), dmax_now)
+                // 5. line search, with the slope along the limited step
+                let slope = decrement * (run.d_max / dmax_now).min(1.0);
+                (run.line_search(&mut state, &delta, energy, slope), dmax_now)
             };
             if opts.trace {
                 tracing::info!(

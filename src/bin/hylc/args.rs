@@ -48,6 +48,10 @@ pub struct SolverArgs {
     /// 4, …, 16 steps (doubled after each consecutive refusal)
     #[arg(long, conflicts_with = "no_inertia")]
     pub exact_backoff: bool,
+    /// line search: after a refused trial step, the next from the parabola through E(0), the slope at 0 and the
+    /// refused trial's energy (within 0.1–0.5 of the refused step) instead of the fixed factor 0.1
+    #[arg(long)]
+    pub interpolating_search: bool,
     /// displacement limit factor: no vertex moves more than F · r · λ_min(Ī) per Newton step (the design's 1)
     #[arg(long, default_value_t = 1.0, value_name = "F", value_parser = positive_finite, allow_hyphen_values = true)]
     pub step_factor: f64,
@@ -85,6 +89,7 @@ impl SolverArgs {
             trust_region: self.trust_region,
             inertia: !self.no_inertia,
             exact_backoff: self.exact_backoff,
+            interpolating_search: self.interpolating_search,
             step_factor: self.step_factor,
             ..Default::default()
         }

@@ -49,22 +49,31 @@ impl<'p> NewtonRun<'p> {
         kept.then_some(dmax_now)
     }
 
-    /// Backtracking line search on the energy along `delta` (tile dofs) from `state`: trial steps factorⁱ, the
-    /// contact candidates refreshed when the vertices have moved by more than half the margin, the stored frames
-    /// transported to the first trial with a lower energy, which becomes the state. Returns the accepted step.
+    /// Backtracking line search on the energy along `delta` (tile dofs; `slope` = gᵀδ) from `state`: trial steps
+    /// factorⁱ, or by safeguarded quadratic interpolation ([`SolverOptions::interpolating_search`]), down to
+    /// 1e-10; the contact candidates refreshed when the vertices have moved by more than half the margin, the
+    /// stored frames transported to the first trial with a lower energy, which becomes the state. Returns the
+    /// accepted step.
     pub(super) fn line_search(
         &mut self,
         state: &mut MicroState,
         delta: &[f64],
         energy: f64,
+        slope: f64,
     ) -> Option<f64> {
         let problem = self.problem;
         let tl = Instant::now();
         let mut accepted = None;
         let mut step = 1.0;
         let factor = problem.options.backtracking;
+        let interpolate = problem.options.interpolating_search && slope < 0.0;
         let trials = (1e-10f64.ln() / factor.ln()).ceil() as usize;
-        for _ in 0..=trials {
+        // the interpolated steps shrink by 0.5–0.1 per trial: the same floor 1e-10, more trials
+        let max_trials = if interpolate { 4 * trials } else { trials };
+        for _ in 0..=max_trials {
+            if interpolate && step < 1e-10 {
+                break;
+            }
             let trial: Vec<f64> = state
                 .y
                 .iter()
@@ -74,14 +83,18 @@ impl<'p> NewtonRun<'p> {
             let (e, positions) = self.trial_energy(state, &trial);
             if e < energy {
                 if self.crossing_rejected(&state.y, &trial) {
-                    step *= factor;
+                    step *= if interpolate { 0.1 } else { factor };
                     continue;
                 }
                 self.accept_trial(state, trial, positions);
                 accepted = Some(step);
                 break;
             }
-            step *= factor;
+            step = if interpolate {
+                interpolated_step(step, e - energy, slope)
+            } else {
+                step * factor
+            };
         }
         self.timings.line_search += tl.elapsed().as_secs_f64();
         accepted
@@ -220,6 +233,18 @@ impl<'p> NewtonRun<'p> {
     }
 }
 
+/// [`SolverOptions::interpolating_search`]: the next trial step after the refused step `t` whose energy change
+/// is `de` (≥ 0 or not finite), for the slope `slope` < 0 at 0: the minimiser of the parabola
+/// p(s) = slope·s + (de − slope·t) s²/t², within [0.1 t, 0.5 t].
+pub(crate) fn interpolated_step(t: f64, de: f64, slope: f64) -> f64 {
+    if !de.is_finite() {
+        return 0.1 * t;
+    }
+    let curvature = de - slope * t; // > 0 since de ≥ 0 > slope·t
+    let s = -slope * t * t / (2.0 * curvature);
+    s.clamp(0.1 * t, 0.5 * t)
+}
+
 /// The trust-region norm of [`SolverOptions::trust_region`] on a step x in the scaled unknowns (ũ, r θ) of a tile
 /// with `n` vertices: the largest vertex displacement (as the displacement limit measures it) or |r δθ|.
 struct VertexNorm {
@@ -270,5 +295,28 @@ impl TrustNorm for VertexNorm {
         } else {
             0.0
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::interpolated_step;
+
+    /// On an energy that is a parabola along the step, the interpolated trial is its minimiser (when that lies
+    /// within [0.1 t, 0.5 t]); outside it is clamped; a non-finite trial energy gives 0.1 t.
+    #[test]
+    fn interpolated_step_is_the_parabola_minimiser_within_its_bounds() {
+        // E(s) − E(0) = slope·s + c s², minimum at −slope / (2c)
+        let (slope, t) = (-2.0, 0.8);
+        for c in [3.0, 5.0, 6.0] {
+            let de = slope * t + c * t * t;
+            let s = interpolated_step(t, de, slope);
+            assert!((s - (-slope / (2.0 * c))).abs() < 1e-14, "c {c}: {s}");
+        }
+        // a nearly linear energy (minimum far out) and a steep wall (minimum near 0)
+        assert_eq!(interpolated_step(t, 1e-12, slope), 0.5 * t);
+        assert_eq!(interpolated_step(t, 1e6, slope), 0.1 * t);
+        assert_eq!(interpolated_step(t, f64::INFINITY, slope), 0.1 * t);
+        assert_eq!(interpolated_step(t, f64::NAN, slope), 0.1 * t);
     }
 }
