@@ -234,7 +234,7 @@ impl<'p> NewtonRun<'p> {
 }
 
 /// [`SolverOptions::interpolating_search`]: the next trial step after the refused step `t` whose energy change
-/// is `de` (≥ 0 or not finite), for the slope `slope` < 0 at 0: the minimiser of the parabola
+/// is `de` (≥ 0 under simple decrease, or not finite), for the slope `slope` < 0 at 0: the minimiser of the parabola
 /// p(s) = slope·s + (de − slope·t) s²/t², within [0.1 t, 0.5 t].
 pub(crate) fn interpolated_step(t: f64, de: f64, slope: f64) -> f64 {
     if !de.is_finite() {
@@ -313,8 +313,12 @@ mod tests {
             let s = interpolated_step(t, de, slope);
             assert!((s - (-slope / (2.0 * c))).abs() < 1e-14, "c {c}: {s}");
         }
-        // a nearly linear energy (minimum far out) and a steep wall (minimum near 0)
-        assert_eq!(interpolated_step(t, 1e-12, slope), 0.5 * t);
+        // a refused trial with a tiny rise: the parabola's minimiser approaches t/2 from below (the upper bound
+        // binds only for a fall, de < 0, that a caller with simple decrease never passes)
+        let s = interpolated_step(t, 1e-12, slope);
+        assert!(s <= 0.5 * t && 0.5 * t - s < 1e-9, "{s}");
+        assert_eq!(interpolated_step(t, -1.0, slope), 0.5 * t);
+        // a steep wall (minimum near 0)
         assert_eq!(interpolated_step(t, 1e6, slope), 0.1 * t);
         assert_eq!(interpolated_step(t, f64::INFINITY, slope), 0.1 * t);
         assert_eq!(interpolated_step(t, f64::NAN, slope), 0.1 * t);
