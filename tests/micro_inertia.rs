@@ -5,15 +5,29 @@ use hylc::generate::default_pattern;
 use hylc::micro::{MacroStrain, MicroProblem, Solution, SolverOptions, Status};
 use hylc::rod::YarnMaterial;
 
-fn problem(inertia: bool) -> MicroProblem {
+fn solver(options: SolverOptions) -> MicroProblem {
     MicroProblem::new(
         default_pattern("plain").unwrap(),
         &YarnMaterial::default(),
-        SolverOptions {
-            inertia,
-            ..Default::default()
-        },
+        options,
     )
+}
+
+fn problem(inertia: bool) -> MicroProblem {
+    solver(SolverOptions {
+        inertia,
+        ..Default::default()
+    })
+}
+
+/// An option that is off by default is written to the settings JSON only while on (`on` = the defaults with it
+/// set), and the JSON reads back.
+fn written_only_while_on(on: SolverOptions, key: &str) {
+    let off = serde_json::to_string(&SolverOptions::default()).unwrap();
+    assert!(!off.contains(key), "{off}");
+    let json = serde_json::to_string(&on).unwrap();
+    assert!(json.contains(&format!("\"{key}\":true")), "{json}");
+    assert_eq!(serde_json::from_str::<SolverOptions>(&json).unwrap(), on);
 }
 
 /// Both rules converge at `z` to the same Ψ̄ (1e-8 relative).
@@ -88,34 +102,19 @@ fn inertia_is_the_default_and_an_old_settings_record_reads_as_off() {
 fn exact_backoff_changes_the_path_not_the_equilibrium() {
     let z = MacroStrain::new(-0.4, 0.0, 0.0, 0.0, 150.0);
     let every_step = problem(true).solve(&z, None).unwrap();
-    let backoff = MicroProblem::new(
-        default_pattern("plain").unwrap(),
-        &YarnMaterial::default(),
-        SolverOptions {
-            exact_backoff: true,
-            ..Default::default()
-        },
-    )
-    .solve(&z, None)
-    .unwrap();
+    let on = SolverOptions {
+        exact_backoff: true,
+        ..Default::default()
+    };
+    let backoff = solver(on.clone()).solve(&z, None).unwrap();
     same_equilibrium(&z, &every_step, &backoff);
     assert_ne!(
         (every_step.steps, every_step.exact_steps),
         (backoff.steps, backoff.exact_steps),
         "the backoff skipped no exact attempt"
     );
-    let off = SolverOptions::default();
-    assert!(!off.exact_backoff);
-    assert!(!serde_json::to_string(&off)
-        .unwrap()
-        .contains("exact_backoff"));
-    let on = SolverOptions {
-        exact_backoff: true,
-        ..Default::default()
-    };
-    let json = serde_json::to_string(&on).unwrap();
-    assert!(json.contains("\"exact_backoff\":true"), "{json}");
-    assert_eq!(serde_json::from_str::<SolverOptions>(&json).unwrap(), on);
+    assert!(!SolverOptions::default().exact_backoff);
+    written_only_while_on(on, "exact_backoff");
 }
 
 /// `SolverOptions::interpolating_search`: on the compressed, bent plain weave solved cold (a solve that
@@ -125,31 +124,16 @@ fn exact_backoff_changes_the_path_not_the_equilibrium() {
 fn interpolating_search_changes_the_path_not_the_equilibrium() {
     let z = MacroStrain::new(-0.4, 0.0, 0.0, 0.0, 150.0);
     let factor = problem(true).solve(&z, None).unwrap();
-    let interpolated = MicroProblem::new(
-        default_pattern("plain").unwrap(),
-        &YarnMaterial::default(),
-        SolverOptions {
-            interpolating_search: true,
-            ..Default::default()
-        },
-    )
-    .solve(&z, None)
-    .unwrap();
+    let on = SolverOptions {
+        interpolating_search: true,
+        ..Default::default()
+    };
+    let interpolated = solver(on.clone()).solve(&z, None).unwrap();
     same_equilibrium(&z, &factor, &interpolated);
     assert_ne!(
         factor.steps, interpolated.steps,
         "the interpolated trial steps changed nothing"
     );
-    let off = SolverOptions::default();
-    assert!(!off.interpolating_search);
-    assert!(!serde_json::to_string(&off)
-        .unwrap()
-        .contains("interpolating_search"));
-    let on = SolverOptions {
-        interpolating_search: true,
-        ..Default::default()
-    };
-    let json = serde_json::to_string(&on).unwrap();
-    assert!(json.contains("\"interpolating_search\":true"), "{json}");
-    assert_eq!(serde_json::from_str::<SolverOptions>(&json).unwrap(), on);
+    assert!(!SolverOptions::default().interpolating_search);
+    written_only_while_on(on, "interpolating_search");
 }

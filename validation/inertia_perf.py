@@ -42,15 +42,12 @@ def load(path):
         return {r["index"]: r for r in map(json.loads, f)}
 
 
-def run(args, pattern, shard, variant):
-    """Solves one chain (skipped when its sample file and CPU time exist); returns (records, CPU seconds)."""
-    stem = f"{OUT}/{pattern}_{shard}_{variant}{args.tag}"
+def timed_sample(cmd, stem, label):
+    """Runs `cmd` (an `hylc sample … --out stem.jsonl`) with RAYON_NUM_THREADS=1 unless `stem`.jsonl and its CPU
+    time `stem`.cpu both exist; returns the CPU seconds (user + sys of the child, from getrusage)."""
     if not (os.path.exists(stem + ".cpu") and os.path.exists(stem + ".jsonl")):
         if os.path.exists(stem + ".jsonl"):
             os.remove(stem + ".jsonl")  # an interrupted run: its CPU time is lost, so measure it again
-        cmd = [args.hylc, "sample", f"{SHARED}/data/hylc2020/patterns/{pattern}.pyp", "--plan", f"{OUT}/reduced.json",
-               "--shard", f"{shard}/14", "--out", stem + ".jsonl"] + args.extra.split()
-        cmd += (args.base if variant == "off" else args.new).split()
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         p = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, RAYON_NUM_THREADS="1"))
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -59,9 +56,19 @@ def run(args, pattern, shard, variant):
         cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
         with open(stem + ".cpu", "w") as f:
             f.write(f"{cpu:.3f}\n")
-        print(f"  {pattern} {CHAINS[shard]} {variant}: {cpu:.2f} s CPU", file=sys.stderr, flush=True)
+        print(f"  {label}: {cpu:.2f} s CPU", file=sys.stderr, flush=True)
     with open(stem + ".cpu") as f:
-        return load(stem + ".jsonl"), float(f.read())
+        return float(f.read())
+
+
+def run(args, pattern, shard, variant):
+    """Solves one chain (skipped when its sample file and CPU time exist); returns (records, CPU seconds)."""
+    stem = f"{OUT}/{pattern}_{shard}_{variant}{args.tag}"
+    cmd = [args.hylc, "sample", f"{SHARED}/data/hylc2020/patterns/{pattern}.pyp", "--plan", f"{OUT}/reduced.json",
+           "--shard", f"{shard}/14", "--out", stem + ".jsonl"] + args.extra.split()
+    cmd += (args.base if variant == "off" else args.new).split()
+    cpu = timed_sample(cmd, stem, f"{pattern} {CHAINS[shard]} {variant}")
+    return load(stem + ".jsonl"), cpu
 
 
 def steps_summary(recs):

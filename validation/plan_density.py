@@ -17,23 +17,11 @@ usage: validation/plan_density.py [--hylc BIN] [--chains 0-4,9] [--counts-1d 30,
 import argparse
 import json
 import os
-import resource
-import statistics
 import subprocess
-import sys
 
-SHARED = os.environ.get("HYLC_SHARED", "../shared")
+from inertia_perf import CHAINS, SHARED, shard_list, steps_summary, timed_sample
+
 OUT = "validation/plan_density"
-CHAINS = ["s_x", "s_a", "s_y", "II00", "II11", "s_x×s_a", "s_x×s_y", "s_a×s_y", "s_x×II00", "s_x×II11",
-          "s_a×II00", "s_a×II11", "s_y×II00", "s_y×II11"]
-
-
-def int_list(text):
-    out = []
-    for part in text.split(","):
-        a, _, b = part.partition("-")
-        out += list(range(int(a), int(b or a) + 1))
-    return out
 
 
 def plan_file(args, c1, c2):
@@ -52,23 +40,11 @@ def plan_file(args, c1, c2):
 def run(args, pattern, chain, c1, c2):
     """One chain at one density (skipped when its sample file and CPU time exist): (records, CPU seconds)."""
     stem = f"{OUT}/{pattern}_{chain}_{c1}_{c2}{args.tag}"
-    if not (os.path.exists(stem + ".cpu") and os.path.exists(stem + ".jsonl")):
-        if os.path.exists(stem + ".jsonl"):
-            os.remove(stem + ".jsonl")  # an interrupted run: its CPU time is lost, so measure it again
-        cmd = [args.hylc, "sample", f"{SHARED}/data/hylc2020/patterns/{pattern}.pyp", "--plan",
-               plan_file(args, c1, c2), "--shard", f"{chain}/14", "--out", stem + ".jsonl"] + args.extra.split()
-        before = resource.getrusage(resource.RUSAGE_CHILDREN)
-        p = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, RAYON_NUM_THREADS="1"))
-        after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        if p.returncode not in (0, 3):
-            sys.exit(f"{' '.join(cmd)}: exit {p.returncode}\n{p.stderr}")
-        cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-        with open(stem + ".cpu", "w") as f:
-            f.write(f"{cpu:.3f}\n")
+    cmd = [args.hylc, "sample", f"{SHARED}/data/hylc2020/patterns/{pattern}.pyp", "--plan",
+           plan_file(args, c1, c2), "--shard", f"{chain}/14", "--out", stem + ".jsonl"] + args.extra.split()
+    cpu = timed_sample(cmd, stem, f"{pattern} {CHAINS[chain]} {c1}/{c2}")
     with open(stem + ".jsonl") as f:
-        recs = [json.loads(line) for line in f]
-    with open(stem + ".cpu") as f:
-        return recs, float(f.read())
+        return [json.loads(line) for line in f], cpu
 
 
 def main():
@@ -82,13 +58,13 @@ def main():
     ap.add_argument("patterns", nargs="+")
     args = ap.parse_args()
     os.makedirs(OUT, exist_ok=True)
-    counts_1d = int_list(args.counts_1d)
-    counts_2d = int_list(args.counts_2d)
+    counts_1d = shard_list(args.counts_1d)
+    counts_2d = shard_list(args.counts_2d)
     print("| pattern | chain | samples | CPU (s) | CPU per sample (ms) | per sample against the sparsest | "
           "Newton steps | warm steps, median / mean | not converged |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for pattern in args.patterns:
-        for chain in int_list(args.chains):
+        for chain in shard_list(args.chains):
             one_d = chain < 5
             base = None
             for count in counts_1d if one_d else counts_2d:
@@ -96,11 +72,10 @@ def main():
                 recs, cpu = run(args, pattern, chain, c1, c2)
                 per = cpu / len(recs)
                 base = base or per
-                warm = [r["steps"] for r in recs if r["start"] != "cold"] or [r["steps"] for r in recs]
+                steps, median, mean = steps_summary(recs)
                 failed = sum(1 for r in recs if r["status"] != "Converged")
                 print(f"| {pattern} | {CHAINS[chain]} | {len(recs)} | {cpu:.1f} | {1e3 * per:.0f} | "
-                      f"{per / base:.2f} | {sum(r['steps'] for r in recs)} | "
-                      f"{statistics.median(warm):g} / {statistics.mean(warm):.1f} | {failed} |", flush=True)
+                      f"{per / base:.2f} | {steps} | {median:g} / {mean:.1f} | {failed} |", flush=True)
 
 
 if __name__ == "__main__":
