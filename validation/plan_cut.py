@@ -88,8 +88,24 @@ def main():
     ap.add_argument("samples")
     args = ap.parse_args()
     cuts = [float(c) for c in args.cuts.split(",")]
+    meta = args.samples.removesuffix(".jsonl") + ".meta.json"
+    for path in (args.samples, meta):
+        if not os.path.exists(path):
+            raise SystemExit(f"{path}: no such file (a sample file of `hylc sample` and its sidecar are needed)")
+    records = []
     with open(args.samples) as f:
-        records = [json.loads(line) for line in f if line.strip()]
+        for n, line in enumerate(f, 1):
+            if line.strip():
+                try:
+                    record = json.loads(line)
+                except json.JSONDecodeError as e:
+                    raise SystemExit(f"{args.samples}:{n}: not a JSON record ({e})")
+                missing = [k for k in ("index", "z", "psi", "status", "time") if k not in record]
+                if missing:
+                    raise SystemExit(f"{args.samples}:{n}: not a sample record (no {', '.join(missing)})")
+                records.append(record)
+    if not records:
+        raise SystemExit(f"{args.samples}: no records")
     total = sum(r["time"] for r in records)
     print(f"{args.samples}: {len(records)} samples, {total:.1f} s of solve time")
     print("| cut | samples kept | share of the solve time | not converged among the kept |")
@@ -99,7 +115,6 @@ def main():
         share = sum(r["time"] for r in k) / total
         failed = sum(r["status"] != "Converged" for r in k)
         print(f"| {cut} | {len(k)} of {len(records)} | {share:.3f} | {failed} |")
-    meta = args.samples.removesuffix(".jsonl") + ".meta.json"
     plan = read_plan(meta)
     half = [in_half_plane(plan, r) for r in records]
     share = sum(r["time"] for r, h in zip(records, half) if h) / total
