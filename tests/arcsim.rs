@@ -8,7 +8,8 @@ mod common;
 
 use hylc::material::synthetic::default_material;
 use hylc::shell::arcsim::{self, Converted};
-use hylc::shell::scene::{ObstacleSpec, Scene, Selection, Transform};
+use hylc::shell::motion::Motion;
+use hylc::shell::scene::{Interpolation, Keyframe, ObstacleSpec, Scene, Selection, Transform};
 use hylc::shell::{Mesh, Psd, ShellError};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -85,7 +86,7 @@ const FULL: &str = r#"{
     "wind": {"density": 3, "drag": 0.5, "velocity": [1, 0, 0]},
     "motions": [[
         {"time": 0, "transform": {"translate": [0, 0, 0]}},
-        {"time": 0.5, "transform": {"translate": [-0.1, 0, 0]}}
+        {"time": 0.5, "transform": {"translate": [-0.1, 0, 0]}, "velocity": {"translate": [0, 0, 0.2]}}
     ], [
         {"time": 0, "transform": {"translate": [0, 0, 0]}},
         {"time": 0.25, "transform": {"translate": [0.05, 0, 0.01], "rotate": [0, 0, 0, 1], "scale": 1}},
@@ -93,7 +94,8 @@ const FULL: &str = r#"{
     ]],
     "handlebars": [{BARS}],
     "handlespheres": [{"center": [-1, -1, 0.5], "radius": 0.25}],
-    "obstacles": [{"mesh": "meshes/tet.obj", "transform": {"scale": 0.5, "translate": [0, 0, -1]}}],
+    "handles": [{"nodes": [120], "motion": 0}],
+    "obstacles": [{"mesh": "meshes/tet.obj", "transform": {"scale": 0.5, "translate": [0, 0, -1]}, "motion": 0}],
     "gravity": [0, 0, -9.8],
     "obs_friction": 0.2,
     "magic": {"handle_stiffness": 5e4, "repulsion_thickness": 4e-3}
@@ -157,8 +159,11 @@ fn handlebars_hold_the_exact_strip_on_each_side() {
         set(&far, &along, true),     // top: y rows 6–8
     ];
     let names = ["left", "bottom", "right", "top"];
-    assert_eq!(c.scene.handles.len(), 4);
-    for (s, h) in c.scene.handles.iter().enumerate() {
+    // the four bars, then the handle sphere and the node handle
+    assert_eq!(c.scene.handles.len(), 6);
+    assert_eq!(c.scene.handles[4].name, "sphere0");
+    assert_eq!(c.scene.handles[5].name, "nodes0");
+    for (s, h) in c.scene.handles.iter().take(4).enumerate() {
         assert_eq!(h.name, names[s]);
         assert!(matches!(h.select, Selection::Box { .. }), "{:?}", h.select);
         assert_eq!(h.select.select(&mesh, &x0), expected[s], "side {s}");
@@ -211,15 +216,19 @@ fn motions_handlespheres_and_every_honoured_key() {
     assert_eq!(s.handle_stiffness, Some(5e4));
     assert_eq!(s.psd, Psd::Psi);
     assert_eq!(s.output.obj_every, 1);
-    // motion 1: three translation keyframes (the identity rotate and scale are accepted)
+    // motion 1: three translation keyframes (the identity rotate and scale are accepted), interpolated as
+    // ARCSim does
     assert_eq!(
         s.handles[0].keyframes,
         vec![
-            (0.0, [0.0; 3]),
-            (0.25, [0.05, 0.0, 0.01]),
-            (0.5, [0.1, 0.0, 0.0])
+            Keyframe::at(0.0, [0.0; 3]),
+            Keyframe::at(0.25, [0.05, 0.0, 0.01]),
+            Keyframe::at(0.5, [0.1, 0.0, 0.0])
         ]
     );
+    assert_eq!(s.handles[0].interpolation, Interpolation::Hermite);
+    let mut motion0 = Motion::hermite(&[(0.0, [0.0; 3]), (0.5, [-0.1, 0.0, 0.0])]);
+    motion0.keyframes[1].velocity = Some([0.0, 0.0, 0.2]);
     assert_eq!(
         s.obstacles,
         vec![ObstacleSpec::Mesh {
@@ -228,22 +237,35 @@ fn motions_handlespheres_and_every_honoured_key() {
                 scale: 0.5,
                 translate: [0.0, 0.0, -1.0],
                 rotate: [0.0, 0.0, 0.0, 1.0]
-            }
+            },
+            motion: Some(motion0.clone()),
         }]
     );
+    // the node handle: vertex 120 (the far corner) following motion 0, whose last keyframe gives a velocity
+    let nodes = &s.handles[2];
+    assert_eq!(nodes.name, "nodes0");
+    assert_eq!(nodes.select, Selection::Vertices(vec![120]));
+    assert_eq!(nodes.motion(), motion0);
     // the handlesphere: a ball of the initial (transformed) positions: vertex (0, 0) sits at its centre,
     // (1, 0) and (0, 1) 0.2 away are inside, (1, 1) 0.28 away is not
     let dir = f.root.join("tests/conf");
     let (mesh, x0) = cloth(s, &dir);
-    assert_eq!(
-        s.pins,
-        vec![Selection::Ball {
-            center: [-1.0, -1.0, 0.5],
-            radius: 0.25
-        }]
+    assert!(s.pins.is_empty());
+    let sphere = &s.handles[1];
+    assert_eq!(sphere.name, "sphere0");
+    assert!(
+        sphere.keyframes.is_empty(),
+        "a handle sphere without a motion stays put"
     );
     assert_eq!(
-        s.pins[0].select(&mesh, &x0),
+        sphere.select,
+        Selection::Ball {
+            center: [-1.0, -1.0, 0.5],
+            radius: 0.25
+        }
+    );
+    assert_eq!(
+        sphere.select.select(&mesh, &x0),
         vec![v(0, 0), v(1, 0), v(0, 1)]
     );
     assert!(c.warnings.is_empty(), "{:?}", c.warnings);
@@ -340,7 +362,7 @@ fn ignored_and_unknown_keys_warn_once_each() {
 }
 
 /// Bad inputs: (what is replaced in [`FULL`] with one handlebar, by what, the key the error must name).
-const BAD: [(&str, &str, &str); 14] = [
+const BAD: [(&str, &str, &str); 22] = [
     (
         "\"frame_time\": 0.01",
         "\"frame_time\": NaN",
@@ -395,6 +417,38 @@ const BAD: [(&str, &str, &str); 14] = [
         "\"center\": [-1, -1, 0.5], \"radius\": 0.25",
         "\"center\": [5, 5, 5], \"radius\": 0.01",
         "`handlespheres[0]`",
+    ),
+    (
+        "{\"time\": 0.5, \"transform\": {\"translate\": [-0.1",
+        "{\"time\": 0, \"transform\": {\"translate\": [-0.1",
+        "`motions[0][1].time`",
+    ),
+    (
+        "\"velocity\": {\"translate\": [0, 0, 0.2]}",
+        "\"velocity\": [0, 0, 0.2]",
+        "`motions[0][1].velocity`",
+    ),
+    (
+        "\"velocity\": {\"translate\": [0, 0, 0.2]}",
+        "\"velocity\": {\"translate\": [0, 0.2]}",
+        "`motions[0][1].velocity.translate`",
+    ),
+    (
+        "\"velocity\": {\"translate\": [0, 0, 0.2]}",
+        "\"velocity\": {\"translate\": [0, 0, 0.2], \"rotate\": [10, 0, 0, 1]}",
+        "`motions[0][1].velocity.rotate`",
+    ),
+    ("\"nodes\": [120]", "\"nodes\": [121]", "`handles[0].nodes`"),
+    ("\"nodes\": [120]", "\"nodes\": []", "`handles[0].nodes`"),
+    (
+        "\"nodes\": [120], \"motion\": 0",
+        "\"nodes\": [120], \"motion\": 3",
+        "`handles[0].motion`",
+    ),
+    (
+        "[0, 0, -1]}, \"motion\": 0",
+        "[0, 0, -1]}, \"motion\": -1",
+        "`obstacles[0].motion`",
     ),
 ];
 
@@ -561,7 +615,14 @@ fn the_originals_scenes_convert_and_build() {
                 }
             }
         } else {
-            assert_eq!(c.scene.pins.len(), 2, "{name}");
+            // the handle spheres are fixed handles, each reporting its reaction by name
+            let names: Vec<&str> = c.scene.handles.iter().map(|h| h.name.as_str()).collect();
+            assert_eq!(names, ["sphere0", "sphere1"], "{name}");
+            assert!(
+                c.scene.handles.iter().all(|h| h.keyframes.is_empty()),
+                "{name}"
+            );
+            assert!(c.scene.pins.is_empty(), "{name}");
             assert_eq!(c.scene.obstacles.len(), 1, "{name}");
         }
     }

@@ -160,7 +160,36 @@ fn physical_parameters_out_of_range_are_errors_naming_the_field() {
             Box::new(|s| {
                 s.handles = scene::builtin("stretch-x").unwrap().handles;
                 s.pins.clear();
-                s.handles[0].keyframes[1].1 = [1e300, 0.0, 0.0];
+                s.handles[0].keyframes[1].offset = [1e300, 0.0, 0.0];
+            }),
+        ),
+        (
+            "field `handles[0].keyframes`: keyframe 1: the velocity",
+            Box::new(|s| {
+                s.handles = scene::builtin("stretch-x").unwrap().handles;
+                s.pins.clear();
+                s.handles[0].keyframes[1].velocity = Some([f64::NAN, 0.0, 0.0]);
+            }),
+        ),
+        (
+            "field `handles[1].keyframes`: keyframe 0 gives a velocity, which only a Hermite motion uses",
+            Box::new(|s| {
+                s.handles = scene::builtin("stretch-x").unwrap().handles;
+                s.pins.clear();
+                s.handles[1].interpolation = hylc::shell::scene::Interpolation::Linear;
+                s.handles[1].keyframes[0].velocity = Some([0.0; 3]);
+            }),
+        ),
+        (
+            "field `obstacles[0].motion`: keyframe 1: times must increase, got 0.5 after 0.5",
+            Box::new(|s| {
+                let mut m = hylc::shell::motion::Motion::hermite(&[(0.5, [0.0; 3]), (0.5, [0.0; 3])]);
+                m.keyframes[0].velocity = None;
+                s.obstacles = vec![hylc::shell::scene::ObstacleSpec::Sphere {
+                    center: [0.0, 0.0, -1.0],
+                    radius: 0.5,
+                    motion: Some(m),
+                }]
             }),
         ),
         (
@@ -169,6 +198,7 @@ fn physical_parameters_out_of_range_are_errors_naming_the_field() {
                 s.obstacles = vec![hylc::shell::scene::ObstacleSpec::Sphere {
                     center: [0.0, 0.0, -1e300],
                     radius: 1.0,
+                    motion: None,
                 }]
             }),
         ),
@@ -209,6 +239,7 @@ fn physical_parameters_out_of_range_are_errors_naming_the_field() {
                 s.obstacles = vec![hylc::shell::scene::ObstacleSpec::Plane {
                     point: [0.0; 3],
                     normal: [0.0, 0.0, 1e-200],
+                    motion: None,
                 }]
             }),
         ),

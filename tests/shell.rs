@@ -6,7 +6,7 @@ mod common;
 use hylc::material::synthetic::default_material;
 use hylc::shell::assemble::energy;
 use hylc::shell::scene::Scene;
-use hylc::shell::solver::{Boundary, Handle, Settings, Simulation};
+use hylc::shell::solver::{Boundary, Handle, Motion, Settings, Simulation};
 use hylc::shell::{ElementModel, Mesh, ModelFlags, Psd};
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 use rand::{Rng, SeedableRng};
@@ -206,12 +206,12 @@ fn uniaxial_strip(material: &hylc::material::Material, name: &str) {
         Handle {
             name: "left".into(),
             vertices: ends(true),
-            keyframes: vec![(0.0, [0.0; 3])],
+            motion: Motion::linear(&[(0.0, [0.0; 3])]),
         },
         Handle {
             name: "right".into(),
             vertices: ends(false),
-            keyframes: vec![(0.0, [0.0; 3]), (1.0, [stretch, 0.0, 0.0])],
+            motion: Motion::linear(&[(0.0, [0.0; 3]), (1.0, [stretch, 0.0, 0.0])]),
         },
     ];
     let settings = Settings {

@@ -67,6 +67,7 @@ fn slide(deg: f64) -> f64 {
     s.obstacles = vec![ObstacleSpec::Plane {
         point: [0.0; 3],
         normal: n,
+        motion: None,
     }];
     let (a, b, _) = run_mean(&s);
     // downhill is −u
@@ -200,6 +201,7 @@ fn a_cloth_rests_on_a_mesh_obstacle_without_passing_through_it() {
             scale: 0.03,
             ..Transform::default()
         },
+        motion: None,
     }];
     let (mut sim, tris) = s.build("scene.json", &dir).unwrap();
     scene::run(&mut sim, &tris, s.steps(), 0, None, |_| {}).unwrap();
@@ -228,6 +230,7 @@ fn a_cloth_rests_on_a_mesh_obstacle_without_passing_through_it() {
     s.obstacles = vec![ObstacleSpec::Mesh {
         path: "fan.obj".into(),
         transform: Transform::default(),
+        motion: None,
     }];
     let err = s.build("scene.json", &dir).err().unwrap().to_string();
     assert!(

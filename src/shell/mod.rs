@@ -18,6 +18,7 @@ pub mod dissipation;
 pub mod element;
 pub mod fold;
 pub mod mesh;
+pub mod motion;
 pub mod obstacle;
 pub mod render;
 pub mod scene;
@@ -83,7 +84,7 @@ pub enum ShellError {
     Selection {
         file: String,
         field: String,
-        /// "selects no vertex", "overlaps a pin"
+        /// "selects no vertex"
         problem: &'static str,
     },
     /// A vertex selection of a scene listing a vertex index the mesh does not have.
@@ -109,6 +110,9 @@ pub enum ShellError {
     /// An obstacle mesh that cannot be used (not a manifold, consistently oriented triangle mesh).
     #[error("{file}: {problem}")]
     ObstacleMesh { file: String, problem: String },
+    /// More obstacle motions than obstacles were given to a simulation.
+    #[error("{motions} obstacle motions for {obstacles} obstacles (one per obstacle at most)")]
+    ObstacleMotions { motions: usize, obstacles: usize },
     /// A scene's simulation could not be set up.
     #[error("{file}: {source}")]
     SceneSetup {

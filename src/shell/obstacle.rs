@@ -196,6 +196,25 @@ fn dot3(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 impl Feature {
+    /// The feature translated by `o` (m): the closest feature of a shape translated by o to p is the closest
+    /// feature of the shape to p − o, translated.
+    pub fn translated(&self, o: [f64; 3]) -> Feature {
+        let add = |p: [f64; 3]| std::array::from_fn(|c| p[c] + o[c]);
+        match *self {
+            Feature::Sphere { center, radius } => Feature::Sphere {
+                center: add(center),
+                radius,
+            },
+            Feature::Face { a, n } => Feature::Face { a: add(a), n },
+            Feature::Edge { a, b, sign } => Feature::Edge {
+                a: add(a),
+                b: add(b),
+                sign,
+            },
+            Feature::Vertex { a, sign } => Feature::Vertex { a: add(a), sign },
+        }
+    }
+
     /// d, ∇d and ∇²d of the feature's distance at p (the radial vector v = p − (closest point) with length r:
     /// n = ±v/r, ∇²d = ±(I − n nᵀ)/r; faces are linear).
     pub fn proximity(&self, p: [f64; 3]) -> Proximity {

@@ -133,7 +133,7 @@ pub fn execute(
         summary,
         positions: sim.positions(),
         triangles: tris,
-        obstacles: sim.obstacles.iter().filter_map(|o| o.surface()).collect(),
+        obstacles: sim.obstacle_surfaces(),
     })
 }
 

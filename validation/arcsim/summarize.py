@@ -5,7 +5,8 @@ Reads <out>/<set>/<scene>/{log.jsonl, frame_NNNN.obj, exit_code, wall_seconds, s
 - <results>: one row per scene (simulated time, steps, wall time per simulated second, Newton iterations per step,
   substeps, steps not converged, exit code, final elastic energy, final bounding box) and the stretch scenes' handle
   forces at 0.1, 0.2, 0.3, 0.4 s (with the original's published 2D stock_stretchX values);
-- <out>/<set>/<scene>/handle_forces.csv for every scene with handles (time, and fx, fy, fz, |F| per handle);
+- (`hylc simulate` itself writes <out>/<set>/<scene>/handle_forces.csv for every scene that holds vertices: time,
+  and fx, fy, fz, |F| per held set);
 - <plots>/arcsim_<set>_<stretchX|stretchY>.png: handle |F| over time for the five materials (1D and 2D; needs
   matplotlib, installed with `pip install --user matplotlib` when missing).
 
@@ -77,21 +78,6 @@ def forces_over_time(steps):
     return [(s["time"], {n: f for n, f in s.get("handle_forces", [])}) for s in steps]
 
 
-def write_forces_csv(run_dir, series):
-    if not series or not series[0][1]:
-        return
-    names = list(series[0][1].keys())
-    with open(os.path.join(run_dir, "handle_forces.csv"), "w") as f:
-        cols = ["time"] + [f"{n}_{c}" for n in names for c in ["fx", "fy", "fz", "norm"]]
-        f.write(",".join(cols) + "\n")
-        for t, fs in series:
-            row = [f"{t:.6g}"]
-            for n in names:
-                v = fs.get(n, [math.nan] * 3)
-                row += [f"{c:.6g}" for c in v] + [f"{norm(v):.6g}"]
-            f.write(",".join(row) + "\n")
-
-
 def force_at(series, t):
     """The handles' forces at the step whose time is closest to t (None when the run did not get there)."""
     if not series or series[-1][0] < t - 0.5 * series[0][0]:
@@ -124,7 +110,6 @@ def summarize_run(set_name, scene, run_dir):
             energy=steps[-1]["energy_elastic"],
         )
     series = forces_over_time(steps)
-    write_forces_csv(run_dir, series)
     row["series"] = series
     obj = last_frame(run_dir)
     row["bbox"] = bounding_box(obj) if obj else None

@@ -4,6 +4,7 @@
 use super::handlebar::{Handlebar, SIDES};
 use super::json::Node;
 use super::read::{join, Ctx, Key};
+use crate::shell::motion::{Interpolation, Keyframe, Motion};
 use crate::shell::scene::{
     ContactSpec, HandleSpec, MeshSpec, ModelSpec, ObstacleSpec, OutputSpec, Placement, Scene,
     Selection, SolverSpec, Transform, Wind,
@@ -23,9 +24,6 @@ pub const DEFAULT_OBS_FRICTION: f64 = 0.3;
 const REMESHING: &str =
     "adaptive remeshing is not part of the HYLC model (the cloth keeps its mesh)";
 
-/// One motion: piecewise-linear translation keyframes (time, offset).
-type Motion = Vec<(f64, [f64; 3])>;
-
 /// Convert the scene `root`; `name` is the produced scene's name.
 pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, ShellError> {
     let top = ctx.fields(
@@ -39,6 +37,7 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
             ("cloths", Used),
             ("wind", Used),
             ("motions", Used),
+            ("handles", Used),
             ("handlebars", Used),
             ("handlespheres", Used),
             ("obstacles", Used),
@@ -210,11 +209,7 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
                 widthp: ctx.fraction(req("widthp")?, &join(&path, "widthp"))?,
                 insetp: ctx.fraction(req("insetp")?, &join(&path, "insetp"))?,
             };
-            let what = match motions.len() {
-                0 => "the index of a motion, but the scene has no `motions`".to_string(),
-                m => format!("the index of one of the scene's {m} motions (0-based)"),
-            };
-            let motion = ctx.index(req("motion")?, &join(&path, "motion"), motions.len(), &what)?;
+            let motion = read_motion_index(ctx, req("motion")?, &path, &motions)?;
             let (select, held) = bar.selection(&mesh, &x0);
             if held.is_empty() {
                 return Err(ctx.error(
@@ -227,19 +222,18 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
             if handles.iter().any(|h| h.name == name) {
                 name = format!("{name}-{i}");
             }
-            handles.push(HandleSpec {
-                name,
-                select,
-                keyframes: motions[motion].clone(),
-            });
+            handles.push(handle(name, select, motion));
             held_by_bars.push(held);
         }
     }
-    let mut pins = Vec::new();
     if let Some(n) = top.get("handlespheres") {
         for (i, s) in ctx.array(n, "handlespheres")?.iter().enumerate() {
             let path = format!("handlespheres[{i}]");
-            let f = ctx.fields(s, &path, &[("center", Used), ("radius", Used)])?;
+            let f = ctx.fields(
+                s,
+                &path,
+                &[("center", Used), ("radius", Used), ("motion", Used)],
+            )?;
             let center = ctx.numbers::<3>(
                 ctx.required(&f, s.line, &path, "center")?,
                 &join(&path, "center"),
@@ -248,6 +242,10 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
                 ctx.required(&f, s.line, &path, "radius")?,
                 &join(&path, "radius"),
             )?;
+            let motion = match f.get("motion") {
+                Some(m) => read_motion_index(ctx, m, &path, &motions)?,
+                None => Motion::fixed(),
+            };
             let sel = Selection::Ball { center, radius };
             let held = sel.select(&mesh, &x0);
             if held.is_empty() {
@@ -267,8 +265,11 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
                     format!("holds vertices that handlebars[{j}] moves too"),
                 ));
             }
-            pins.push(sel);
+            handles.push(handle(format!("sphere{i}"), sel, motion));
         }
+    }
+    if let Some(n) = top.get("handles") {
+        handles.extend(read_node_handles(ctx, n, &motions, mesh.len())?);
     }
 
     // obstacles and contact
@@ -276,16 +277,25 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
     if let Some(n) = top.get("obstacles") {
         for (i, o) in ctx.array(n, "obstacles")?.iter().enumerate() {
             let path = format!("obstacles[{i}]");
-            let f = ctx.fields(o, &path, &[("mesh", Used), ("transform", Used)])?;
+            let f = ctx.fields(
+                o,
+                &path,
+                &[("mesh", Used), ("transform", Used), ("motion", Used)],
+            )?;
             let mesh_node = ctx.required(&f, o.line, &path, "mesh")?;
             let (rel, _) = ctx.resolve(mesh_node, &join(&path, "mesh"))?;
             let transform = match f.get("transform") {
                 Some(t) => read_transform(ctx, t, &join(&path, "transform"))?,
                 None => Transform::default(),
             };
+            let motion = match f.get("motion") {
+                Some(m) => Some(read_motion_index(ctx, m, &path, &motions)?),
+                None => None,
+            };
             obstacles.push(ObstacleSpec::Mesh {
                 path: rel,
                 transform,
+                motion,
             });
         }
     }
@@ -349,7 +359,7 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
         },
         psd: Psd::Psi,
         solver: SolverSpec::default(),
-        pins,
+        pins: Vec::new(),
         handles,
         obstacles,
         contact: ContactSpec {
@@ -420,8 +430,70 @@ fn read_materials(ctx: &mut Ctx, n: &Node) -> Result<f64, ShellError> {
     Ok(damping)
 }
 
-/// `motions`: each a list of keyframes `{"time": t, "transform": {"translate": [..]}}` with increasing times; a
-/// rotation or scale other than the identity is an error (the handles here translate).
+/// A handle of the converted scene following `motion`.
+fn handle(name: String, select: Selection, motion: Motion) -> HandleSpec {
+    HandleSpec {
+        name,
+        select,
+        keyframes: motion.keyframes,
+        interpolation: motion.interpolation,
+    }
+}
+
+/// The `motion` key of the object at `path`: the index of one of the scene's motions.
+fn read_motion_index(
+    ctx: &Ctx,
+    n: &Node,
+    path: &str,
+    motions: &[Motion],
+) -> Result<Motion, ShellError> {
+    let what = match motions.len() {
+        0 => "the index of a motion, but the scene has no `motions`".to_string(),
+        m => format!("the index of one of the scene's {m} motions (0-based)"),
+    };
+    let i = ctx.index(n, &join(path, "motion"), motions.len(), &what)?;
+    Ok(motions[i].clone())
+}
+
+/// ARCSim's node handles, `handles: [{"nodes": [i, …], "motion": m}]`: the listed cloth vertices (0-based, in
+/// the mesh file's order) follow motion m, or stay put without one; named `nodes0`, `nodes1`, ….
+fn read_node_handles(
+    ctx: &mut Ctx,
+    n: &Node,
+    motions: &[Motion],
+    vertices: usize,
+) -> Result<Vec<HandleSpec>, ShellError> {
+    let mut out = Vec::new();
+    for (i, h) in ctx.array(n, "handles")?.iter().enumerate() {
+        let path = format!("handles[{i}]");
+        let f = ctx.fields(h, &path, &[("nodes", Used), ("motion", Used)])?;
+        let key = join(&path, "nodes");
+        let list = ctx.array(ctx.required(&f, h.line, &path, "nodes")?, &key)?;
+        if list.is_empty() {
+            return Err(ctx.error(h.line, &key, "lists no vertex"));
+        }
+        let what = format!("a vertex index of the cloth's mesh (0-based; it has {vertices})");
+        let nodes = list
+            .iter()
+            .map(|v| ctx.index(v, &key, vertices, &what))
+            .collect::<Result<Vec<usize>, _>>()?;
+        let motion = match f.get("motion") {
+            Some(m) => read_motion_index(ctx, m, &path, motions)?,
+            None => Motion::fixed(),
+        };
+        out.push(handle(
+            format!("nodes{i}"),
+            Selection::Vertices(nodes),
+            motion,
+        ));
+    }
+    Ok(out)
+}
+
+/// `motions`: each a list of keyframes `{"time": t, "transform": {"translate": [..]}, "velocity":
+/// {"translate": [..]}}` with increasing times, interpolated as ARCSim does (cubic Hermite; a keyframe without
+/// `velocity` gets ARCSim's: zero at the ends, central differences inside). A rotation or scale other than the
+/// identity is an error (the handles here translate).
 fn read_motions(ctx: &mut Ctx, n: &Node) -> Result<Vec<Motion>, ShellError> {
     let mut out = Vec::new();
     for (i, m) in ctx.array(n, "motions")?.iter().enumerate() {
@@ -430,13 +502,20 @@ fn read_motions(ctx: &mut Ctx, n: &Node) -> Result<Vec<Motion>, ShellError> {
         if keys.is_empty() {
             return Err(ctx.error(m.line, &path, "needs at least one keyframe"));
         }
-        let mut motion: Motion = Vec::new();
+        let mut motion = Motion {
+            keyframes: Vec::new(),
+            interpolation: Interpolation::Hermite,
+        };
         for (j, k) in keys.iter().enumerate() {
             let kp = format!("{path}[{j}]");
-            let f = ctx.fields(k, &kp, &[("time", Used), ("transform", Used)])?;
+            let f = ctx.fields(
+                k,
+                &kp,
+                &[("time", Used), ("transform", Used), ("velocity", Used)],
+            )?;
             let tn = ctx.required(&f, k.line, &kp, "time")?;
             let time = ctx.number(tn, &join(&kp, "time"))?;
-            if let Some(&(prev, _)) = motion.last() {
+            if let Some(prev) = motion.keyframes.last().map(|k| k.time) {
                 if time <= prev {
                     return Err(ctx.error(
                         tn.line,
@@ -445,42 +524,62 @@ fn read_motions(ctx: &mut Ctx, n: &Node) -> Result<Vec<Motion>, ShellError> {
                     ));
                 }
             }
-            let mut offset = [0.0; 3];
-            if let Some(t) = f.get("transform") {
-                let tp = join(&kp, "transform");
-                let tf = ctx.fields(
-                    t,
-                    &tp,
-                    &[("translate", Used), ("rotate", Used), ("scale", Used)],
-                )?;
-                if let Some(r) = tf.get("rotate") {
-                    let rk = join(&tp, "rotate");
-                    let rot = ctx.numbers::<4>(r, &rk)?;
-                    if rot[0] != 0.0 {
-                        return Err(ctx.error(
-                            r.line,
-                            &rk,
-                            "motions are translations here (a keyframe may not rotate)",
-                        ));
-                    }
-                }
-                if let Some(s) = tf.get("scale") {
-                    let sk = join(&tp, "scale");
-                    if ctx.number(s, &sk)? != 1.0 {
-                        return Err(ctx.error(
-                            s.line,
-                            &sk,
-                            "motions are translations here (a keyframe may not scale)",
-                        ));
-                    }
-                }
-                if let Some(v) = tf.get("translate") {
-                    offset = ctx.numbers::<3>(v, &join(&tp, "translate"))?;
-                }
-            }
-            motion.push((time, offset));
+            let offset = match f.get("transform") {
+                Some(t) => read_translation(ctx, t, &join(&kp, "transform"), 1.0)?,
+                None => [0.0; 3],
+            };
+            let velocity = match f.get("velocity") {
+                Some(v) => Some(read_translation(ctx, v, &join(&kp, "velocity"), 0.0)?),
+                None => None,
+            };
+            motion.keyframes.push(Keyframe {
+                time,
+                offset,
+                velocity,
+            });
         }
         out.push(motion);
     }
     Ok(out)
+}
+
+/// The translation of a keyframe's `transform` or `velocity` object (`translate`, 3 numbers); a `rotate` with a
+/// non-zero angle, or a `scale` other than `identity_scale` (1 for a transform, 0 for a velocity), is an error.
+fn read_translation(
+    ctx: &mut Ctx,
+    t: &Node,
+    tp: &str,
+    identity_scale: f64,
+) -> Result<[f64; 3], ShellError> {
+    let tf = ctx.fields(
+        t,
+        tp,
+        &[("translate", Used), ("rotate", Used), ("scale", Used)],
+    )?;
+    if let Some(r) = tf.get("rotate") {
+        let rk = join(tp, "rotate");
+        if ctx.numbers::<4>(r, &rk)?[0] != 0.0 {
+            return Err(ctx.error(
+                r.line,
+                &rk,
+                "motions are translations here (a keyframe may not rotate)",
+            ));
+        }
+    }
+    if let Some(s) = tf.get("scale") {
+        let sk = join(tp, "scale");
+        if ctx.number(s, &sk)? != identity_scale {
+            return Err(ctx.error(
+                s.line,
+                &sk,
+                format!(
+                    "motions are translations here (a keyframe's scale must be {identity_scale})"
+                ),
+            ));
+        }
+    }
+    match tf.get("translate") {
+        Some(v) => ctx.numbers::<3>(v, &join(tp, "translate")),
+        None => Ok([0.0; 3]),
+    }
 }

@@ -9,9 +9,14 @@
 //!   transformed OBJ); `cloths[0].materials[0].damping` → `damping`;
 //! - `frame_time` → `dt` (one implicit step per frame, our adaptive substeps take over where the original took
 //!   `frame_steps` substeps), one OBJ per frame; `end_time` → `duration`;
-//! - `handlebars` → `handles` with a box selection in the rest layout ([`Handlebar`]) following the keyframes of
-//!   `motions[motion]` (piecewise-linear translations); `handlespheres` → `pins` selecting a ball of the initial
-//!   positions; `magic.handle_stiffness` (default 1e3 N/m) → `handle_stiffness`, so pins and handles are springs;
+//! - `motions` → translation keyframes interpolated as ARCSim does (cubic Hermite with its velocities,
+//!   `velocity` keys honoured; [`crate::shell::motion`]);
+//! - `handlebars` → `handles` with a box selection in the rest layout ([`Handlebar`]) following
+//!   `motions[motion]`, named by their side; `handlespheres` → `handles` named `sphere0`, `sphere1`, …
+//!   selecting a ball of the initial positions (fixed, or following their `motion`); node handles
+//!   (`handles: [{"nodes": [..], "motion": m}]`) → `handles` named `nodes0`, … selecting those vertices;
+//!   obstacles with a `motion` move with it; `magic.handle_stiffness` (default 1e3 N/m) → `handle_stiffness`, so
+//!   every held vertex is a spring, and each held set reports its reaction by name;
 //! - `wind` → `wind` (density 1 when absent, as ARCSim), `gravity` (zero when absent, as ARCSim), `obstacles` →
 //!   mesh obstacles, `obs_friction` → `contact.friction` (0.3 when absent, as ARCSim),
 //!   `magic.repulsion_thickness` → `contact.thickness` (default 1e-3 m).

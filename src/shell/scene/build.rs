@@ -58,28 +58,7 @@ impl Scene {
             collapse: self.model.collapse_barrier,
         };
         let model = ElementModel::new(&material, &flags, self.psd);
-        let mut pins = Vec::new();
-        for (i, sel) in self.pins.iter().enumerate() {
-            pins.extend(sel.select_checked(&mesh, &x0, file, format!("pins[{i}]"))?);
-        }
-        let mut handles = Vec::new();
-        for (i, h) in self.handles.iter().enumerate() {
-            let v = h
-                .select
-                .select_checked(&mesh, &x0, file, format!("handles[{i}].select"))?;
-            if v.iter().any(|x| pins.contains(x)) {
-                return Err(ShellError::Selection {
-                    file: file.to_string(),
-                    field: format!("handles[{i}].select"),
-                    problem: "overlaps a pin",
-                });
-            }
-            handles.push(Handle {
-                name: h.name.clone(),
-                vertices: v,
-                keyframes: h.keyframes.clone(),
-            });
-        }
+        let handles = self.held_sets(&mesh, &x0, file)?;
         let settings = Settings {
             dt: self.dt,
             quasi_static: self.quasi_static,
@@ -103,9 +82,14 @@ impl Scene {
             stencils,
             x0,
             Boundary {
-                pinned: pins,
+                pinned: vec![],
                 handles,
                 obstacles,
+                obstacle_motions: self
+                    .obstacles
+                    .iter()
+                    .map(|o| o.motion().cloned().unwrap_or_default())
+                    .collect(),
             },
             settings,
             self.model.mass,
@@ -117,6 +101,60 @@ impl Scene {
         Ok((sim, tris))
     }
 
+    /// Every held vertex set as a named [`Handle`], so that each reports its reaction: the handles under their
+    /// names, then the pins as `pin0`, `pin1`, … (fixed). A set that selects no vertex is an error naming its
+    /// field, and so is one holding a vertex another set holds too when they are hard constraints (with
+    /// `handle_stiffness` each set pulls a shared vertex with its own spring, as ARCSim does).
+    fn held_sets(
+        &self,
+        mesh: &Mesh,
+        x0: &[[f64; 3]],
+        file: &str,
+    ) -> Result<Vec<Handle>, ShellError> {
+        let mut sets: Vec<(String, Handle)> = Vec::new();
+        for (i, h) in self.handles.iter().enumerate() {
+            let field = format!("handles[{i}].select");
+            let vertices = h.select.select_checked(mesh, x0, file, field.clone())?;
+            let motion = h.motion();
+            sets.push((
+                field,
+                Handle {
+                    name: h.name.clone(),
+                    vertices,
+                    motion,
+                },
+            ));
+        }
+        for (i, sel) in self.pins.iter().enumerate() {
+            let field = format!("pins[{i}]");
+            let vertices = sel.select_checked(mesh, x0, file, field.clone())?;
+            let name = format!("pin{i}");
+            sets.push((
+                field,
+                Handle {
+                    name,
+                    vertices,
+                    motion: Motion::fixed(),
+                },
+            ));
+        }
+        let mut holder: Vec<Option<usize>> = vec![None; mesh.len()];
+        let hard = self.handle_stiffness.is_none();
+        for (k, (field, h)) in sets.iter().enumerate().filter(|_| hard) {
+            for &v in &h.vertices {
+                if let Some(j) = holder[v] {
+                    return Err(ShellError::scene(
+                        file,
+                        field,
+                        format!("holds vertex {v}, which {} holds too", sets[j].0),
+                    ));
+                }
+                holder[v] = Some(k);
+            }
+        }
+        Ok(sets.into_iter().map(|(_, h)| h).collect())
+    }
+
     /// The obstacles, with their meshes loaded, transformed and checked (errors name `obstacles[i]`).
     pub fn obstacles(&self, file: &str, dir: &Path) -> Result<Vec<Obstacle>, ShellError> {
         self.obstacles
@@ -124,15 +162,17 @@ impl Scene {
             .enumerate()
             .map(|(i, o)| {
                 Ok(match o {
-                    ObstacleSpec::Sphere { center, radius } => Obstacle::Sphere {
+                    ObstacleSpec::Sphere { center, radius, .. } => Obstacle::Sphere {
                         center: *center,
                         radius: *radius,
                     },
-                    ObstacleSpec::Plane { point, normal } => Obstacle::Plane {
+                    ObstacleSpec::Plane { point, normal, .. } => Obstacle::Plane {
                         point: *point,
                         normal: *normal,
                     },
-                    ObstacleSpec::Mesh { path, transform } => {
+                    ObstacleSpec::Mesh {
+                        path, transform, ..
+                    } => {
                         let p = dir.join(path);
                         let (v, t) = load_obj_surface(&p).map_err(|e| ShellError::SceneMesh {
                             file: format!("{file}: obstacles[{i}]"),

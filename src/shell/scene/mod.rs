@@ -23,8 +23,11 @@
 //!   "solver": {"force_tol": 1e-6, "max_newton": 50, "exact_first": true, "max_halvings": 6},
 //!   "pins": [{"near": {"point": [0, 0], "radius": 0.01}}],
 //!   "handles": [{"name": "left", "select": {"box": {"min": [0, 0.05], "max": [0.021, 0.25]}},
-//!                "keyframes": [[0, [0, 0, 0]], [0.25, [-0.02, 0, 0]]]}],
-//!   "obstacles": [{"sphere": {"center": [0.15, 0.15, -0.032], "radius": 0.03}},
+//!                "keyframes": [[0, [0, 0, 0]], [0.25, [-0.02, 0, 0]]],
+//!                "interpolation": "linear"}],     // or "hermite" (`super::motion`); a Hermite keyframe may
+//!                                                 // give its velocity: [t, [x, y, z], [vx, vy, vz]]
+//!   "obstacles": [{"sphere": {"center": [0.15, 0.15, -0.032], "radius": 0.03,
+//!                             "motion": {"keyframes": [[0, [0, 0, 0]], [1, [0, 0, 0.05]]]}}},  // optional
 //!                 {"plane": {"point": [0, 0, -0.5], "normal": [0, 0, 1]}},
 //!                 {"mesh": {"path": "sphere.obj", "transform": {"scale": 0.03, "translate": [0, 0, -0.04]}}}],
 //!   "contact": {"thickness": 0.002, "stiffness": 1e8, "friction": 0.0, "friction_velocity": 1e-3},
@@ -35,11 +38,15 @@
 //! selects by initial 3D position; `{"vertices": [..]}` lists 0-based vertex indices (OBJ order). An OBJ mesh's
 //! `transform` (`scale`, `translate`, `rotate`: [angle in degrees, axis x, y, z], applied in that order) places it:
 //! the rest layout is the scaled OBJ, the initial state the transformed one.
+//!
+//! Every pin and handle reports its reaction in the log (`handle_forces`, and `handle_forces.csv`): handles
+//! under their names, pins as `pin0`, `pin1`, … in the order of `pins`.
 
 pub use super::dissipation::Wind;
 use super::element::{ElementModel, ModelFlags, Psd};
 pub use super::fold::{CollapseBarrier, FoldBarrier};
 use super::mesh::{load_obj_surface, write_obj, Mesh};
+pub use super::motion::{Interpolation, Keyframe, Motion};
 use super::obstacle::{MeshObstacle, Obstacle};
 use super::solver::{Boundary, Handle, Settings, Simulation, StepReport};
 use super::ShellError;
@@ -189,16 +196,33 @@ pub enum ObstacleSpec {
     Sphere {
         center: [f64; 3],
         radius: f64,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        motion: Option<Motion>,
     },
     Plane {
         point: [f64; 3],
         normal: [f64; 3],
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        motion: Option<Motion>,
     },
     Mesh {
         path: String,
         #[serde(default, skip_serializing_if = "Transform::is_identity")]
         transform: Transform,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        motion: Option<Motion>,
     },
+}
+
+impl ObstacleSpec {
+    /// The obstacle's translation over time (none: it stays put).
+    pub fn motion(&self) -> Option<&Motion> {
+        match self {
+            ObstacleSpec::Sphere { motion, .. }
+            | ObstacleSpec::Plane { motion, .. }
+            | ObstacleSpec::Mesh { motion, .. } => motion.as_ref(),
+        }
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
@@ -404,12 +428,30 @@ impl Selection {
     }
 }
 
+/// A handle of a scene file: a named vertex selection following a keyframed translation
+/// ([`Motion`]; `keyframes` and `interpolation` as there).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct HandleSpec {
     pub name: String,
     pub select: Selection,
-    pub keyframes: Vec<(f64, [f64; 3])>,
+    pub keyframes: Vec<Keyframe>,
+    #[serde(default, skip_serializing_if = "is_linear")]
+    pub interpolation: Interpolation,
+}
+
+fn is_linear(i: &Interpolation) -> bool {
+    *i == Interpolation::Linear
+}
+
+impl HandleSpec {
+    /// The handle's motion.
+    pub fn motion(&self) -> Motion {
+        Motion {
+            keyframes: self.keyframes.clone(),
+            interpolation: self.interpolation,
+        }
+    }
 }
 
 /// The most time steps a scene may take (⌈duration / dt⌉): a million steps are hours of wall time even on the

@@ -1,4 +1,4 @@
-//! The runner: one OBJ per frame and one JSON line per step.
+//! The runner: one OBJ per frame, one JSON line per step, and the reactions of the held sets as a table.
 
 use super::*;
 
@@ -17,8 +17,9 @@ pub struct RunSummary {
 }
 
 /// Run a built simulation for `steps` steps, writing `frame_NNNN.obj` (frame 0 the initial state) every
-/// `obj_every` steps and one JSON line per step to `log.jsonl` in `out` (when given). `progress` is called after
-/// every step.
+/// `obj_every` steps, one JSON line per step to `log.jsonl` and, when the scene holds vertices, the reaction
+/// of every held set per step to `handle_forces.csv` (columns `time`, then `NAME_fx`, `NAME_fy`, `NAME_fz`,
+/// `NAME_norm` per set, N) in `out` (when given). `progress` is called after every step.
 pub fn run(
     sim: &mut Simulation,
     tris: &[[usize; 3]],
@@ -28,6 +29,23 @@ pub fn run(
     mut progress: impl FnMut(&StepReport),
 ) -> Result<RunSummary, ShellError> {
     let io = |e: std::io::Error, what: &Path| ShellError::io(what, "cannot write", e);
+    let mut forces = match out {
+        Some(dir) if sim.held_set_names().next().is_some() => {
+            let f = dir.join("handle_forces.csv");
+            std::fs::create_dir_all(dir)
+                .map_err(|e| ShellError::io(dir, "cannot create the folder", e))?;
+            let mut w = std::io::BufWriter::new(std::fs::File::create(&f).map_err(|e| io(e, &f))?);
+            let mut head = String::from("time");
+            for n in sim.held_set_names() {
+                for c in ["fx", "fy", "fz", "norm"] {
+                    head.push_str(&format!(",{n}_{c}"));
+                }
+            }
+            writeln!(w, "{head}").map_err(|e| io(e, &f))?;
+            Some((w, f))
+        }
+        _ => None,
+    };
     let mut log = match out {
         Some(dir) => {
             std::fs::create_dir_all(dir)
@@ -65,6 +83,14 @@ pub fn run(
         if let (Some(dir), Some((w, f))) = (out, log.as_mut()) {
             let line = serde_json::to_string(&r).expect("a step report serialises");
             writeln!(w, "{line}").map_err(|e| io(e, f))?;
+            if let Some((w, f)) = forces.as_mut() {
+                let mut row = format!("{}", r.time);
+                for (_, v) in &r.handle_forces {
+                    let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+                    row.push_str(&format!(",{},{},{},{norm}", v[0], v[1], v[2]));
+                }
+                writeln!(w, "{row}").map_err(|e| io(e, f))?;
+            }
             if obj_every > 0 && k % obj_every == 0 {
                 let f = dir.join(format!("frame_{k:04}.obj"));
                 write_obj(&f, &sim.positions(), tris).map_err(|e| io(e, &f))?;
@@ -73,7 +99,7 @@ pub fn run(
         progress(&r);
         sum.last = Some(r);
     }
-    if let Some((mut w, f)) = log {
+    for (mut w, f) in log.into_iter().chain(forces) {
         w.flush().map_err(|e| io(e, &f))?;
     }
     sum.wall = start.elapsed().as_secs_f64();

@@ -49,15 +49,29 @@ impl Scene {
                 ),
             );
         }
-        for (i, h) in self.handles.iter().enumerate() {
-            if h.keyframes
-                .windows(2)
-                .any(|w| w[1].0.is_nan() || w[1].0 <= w[0].0)
-                || h.keyframes.iter().any(|k| !k.0.is_finite())
-            {
+        let motions = self
+            .handles
+            .iter()
+            .enumerate()
+            .map(|(i, h)| (format!("handles[{i}].keyframes"), h.motion()))
+            .chain(self.obstacles.iter().enumerate().filter_map(|(i, o)| {
+                o.motion()
+                    .map(|m| (format!("obstacles[{i}].motion"), m.clone()))
+            }));
+        for (field, m) in motions {
+            if let Err(e) = m.check() {
+                return bad(&field, e.to_string());
+            }
+            if m.keyframes.iter().any(|k| {
+                !within(&k.offset, MAX_COORDINATE)
+                    || !k.velocity.is_none_or(|v| within(&v, MAX_COORDINATE))
+            }) {
                 return bad(
-                    &format!("handles[{i}].keyframes"),
-                    "times must be finite and increase".into(),
+                    &field,
+                    format!(
+                        "translations must be within ±{MAX_COORDINATE:e} m and velocities within \
+                         ±{MAX_COORDINATE:e} m/s"
+                    ),
                 );
             }
         }
@@ -173,7 +187,6 @@ impl Scene {
     /// [`MAX_AXIS`]).
     fn validate_geometry(&self, file: &str) -> Result<(), ShellError> {
         let bad = |field: &str, msg: String| Err(ShellError::scene(file, field, msg));
-        let within = |v: &[f64], limit: f64| v.iter().all(|x| x.abs() <= limit);
         let pl = &self.placement;
         if !within(&pl.origin, MAX_COORDINATE) {
             return bad(
@@ -186,14 +199,6 @@ impl Scene {
                 "placement",
                 format!("the components of u and v must be within ±{MAX_AXIS:e}"),
             );
-        }
-        for (i, h) in self.handles.iter().enumerate() {
-            if h.keyframes.iter().any(|k| !within(&k.1, MAX_COORDINATE)) {
-                return bad(
-                    &format!("handles[{i}].keyframes"),
-                    format!("offsets must be within ±{MAX_COORDINATE:e} m"),
-                );
-            }
         }
         if let MeshSpec::Obj { transform, .. } = &self.mesh {
             if !transform_ok(transform) {
@@ -212,10 +217,10 @@ impl Scene {
         for (i, o) in self.obstacles.iter().enumerate() {
             let ok = match o {
                 ObstacleSpec::Mesh { transform, .. } => transform_ok(transform),
-                ObstacleSpec::Sphere { center, radius } => {
+                ObstacleSpec::Sphere { center, radius, .. } => {
                     *radius > 0.0 && *radius <= MAX_COORDINATE && within(center, MAX_COORDINATE)
                 }
-                ObstacleSpec::Plane { point, normal } if within(point, MAX_COORDINATE) => {
+                ObstacleSpec::Plane { point, normal, .. } if within(point, MAX_COORDINATE) => {
                     let l = (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2])
                         .sqrt();
                     l > 0.0 && l.is_finite()
@@ -243,4 +248,9 @@ fn transform_ok(t: &Transform) -> bool {
         && t.scale <= MAX_AXIS
         && t.rotate.iter().all(|x| x.is_finite())
         && t.translate.iter().all(|x| x.abs() <= MAX_COORDINATE)
+}
+
+/// Every component within ±limit (false for NaN).
+fn within(v: &[f64], limit: f64) -> bool {
+    v.iter().all(|x| x.abs() <= limit)
 }

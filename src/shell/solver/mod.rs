@@ -23,11 +23,17 @@
 //! [`ShellError::StepFailed`].
 //!
 //! Boundary conditions: pinned vertices keep their initial positions; handle vertices follow keyframed
-//! translations (piecewise linear in time, held after the last key). By default both are hard constraints
-//! (dof elimination); with a handle stiffness k (ARCSim's `handle_stiffness`) every held vertex is instead free
-//! and pulled to its target by a spring ½ k |x − p(t)|². The reaction force of a handle is the force it exerts on
-//! the cloth: with hard constraints Σ over its vertices of ∂Φ/∂x_v (inertia, elastic, gravity, obstacle and
-//! dissipation terms), with springs Σ k (p_v − x_v).
+//! translations ([`Motion`]: piecewise linear or cubic Hermite in time, held after the last key), evaluated at
+//! the end of each substep. By default both are hard constraints (dof elimination); with a handle stiffness k
+//! (ARCSim's `handle_stiffness`) every held vertex is instead free and pulled to its target by a spring
+//! ½ k |x − p(t)|². Every held set reports its reaction, the force it exerts on the cloth: with hard constraints
+//! Σ over its vertices of ∂Φ/∂x_v (inertia, elastic, gravity, obstacle and dissipation terms), with springs
+//! Σ k (p_v − x_v); each handle under its name, the pinned vertices together as `pinned`.
+//!
+//! Obstacles may move ([`Boundary::obstacle_motions`]): obstacle i at time t is its shape translated by
+//! oᵢ(t), so its penalty is evaluated at the end of the substep with the shape at oᵢ(t₁) (the closest feature
+//! of p − oᵢ found in the shape's own placement, then translated), and lagged friction charges the tangential
+//! displacement relative to the obstacle, δ = x − xₙ − (oᵢ(t₁) − oᵢ(tₙ)).
 
 mod linear;
 mod terms;
@@ -36,7 +42,8 @@ use super::assemble::{energy, gather, Assembled, Pattern};
 use super::dissipation::{self, Wind};
 use super::element::ElementModel;
 use super::mesh::Stencil;
-use super::obstacle::{self, Obstacle};
+pub use super::motion::Motion;
+use super::obstacle::{self, Obstacle, Proximity};
 use super::strain::NDOF;
 use super::ShellError;
 use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymbolicCholesky};
@@ -44,42 +51,30 @@ use faer::Side;
 use std::time::Instant;
 use terms::Lagged;
 
-/// A set of vertices following keyframed translations.
+/// A named set of vertices following a keyframed translation from their initial positions.
 #[derive(Clone, Debug)]
 pub struct Handle {
     pub name: String,
     pub vertices: Vec<usize>,
-    /// (time, translation from the initial positions), increasing times
-    pub keyframes: Vec<(f64, [f64; 3])>,
+    pub motion: Motion,
 }
 
 impl Handle {
-    /// Translation at time t (piecewise linear; constant before the first and after the last key).
+    /// Translation at time t ([`Motion::position`]).
     pub fn offset(&self, t: f64) -> [f64; 3] {
-        let k = &self.keyframes;
-        if k.is_empty() {
-            return [0.0; 3];
-        }
-        if t <= k[0].0 {
-            return k[0].1;
-        }
-        for w in k.windows(2) {
-            if t <= w[1].0 {
-                let s = (t - w[0].0) / (w[1].0 - w[0].0);
-                return std::array::from_fn(|c| w[0].1[c] + s * (w[1].1[c] - w[0].1[c]));
-            }
-        }
-        k[k.len() - 1].1
+        self.motion.position(t)
     }
 }
 
 /// Boundary conditions and obstacles of a simulation.
 #[derive(Clone, Debug, Default)]
 pub struct Boundary {
-    /// vertices held at their initial positions
+    /// vertices held at their initial positions (their reaction is reported as `pinned`)
     pub pinned: Vec<usize>,
     pub handles: Vec<Handle>,
     pub obstacles: Vec<Obstacle>,
+    /// the translation of each obstacle over time, in the order of `obstacles` (missing ones stay put)
+    pub obstacle_motions: Vec<Motion>,
 }
 
 /// Solver settings.
@@ -160,7 +155,8 @@ pub struct StepReport {
     /// potential energy of gravity relative to the initial state
     pub energy_gravity: f64,
     pub energy_obstacles: f64,
-    /// (name, force the handle exerts on the cloth, N)
+    /// (name, force the held set exerts on the cloth, N) for every handle, then `pinned` (scenes hold their
+    /// pins as fixed handles named `pin0`, `pin1`, …)
     pub handle_forces: Vec<(String, [f64; 3])>,
     /// the largest diagonal shift the factorisation needed (0: none)
     pub shift: f64,
@@ -253,6 +249,8 @@ pub struct Simulation {
     pub pinned: Vec<usize>,
     pub handles: Vec<Handle>,
     pub obstacles: Vec<Obstacle>,
+    /// one per obstacle
+    pub obstacle_motions: Vec<Motion>,
     pub settings: Settings,
     pub time: f64,
     pub steps: usize,
@@ -272,6 +270,8 @@ type DampingCache = (Vec<f64>, std::sync::Arc<Vec<[[f64; NDOF]; NDOF]>>);
 struct Target {
     /// substep length h
     h: f64,
+    /// the time at the end of the substep, t₁ = tₙ + h
+    time: f64,
     xt: Vec<f64>,
     xn: Vec<f64>,
     /// spring targets of the held vertices (vertex, position) when handles are springs
@@ -320,8 +320,16 @@ impl Simulation {
             pinned,
             handles,
             obstacles,
+            mut obstacle_motions,
         } = boundary;
         let n = x0.len();
+        if obstacle_motions.len() > obstacles.len() {
+            return Err(ShellError::ObstacleMotions {
+                motions: obstacle_motions.len(),
+                obstacles: obstacles.len(),
+            });
+        }
+        obstacle_motions.resize(obstacles.len(), Motion::fixed());
         if !(settings.dt > 0.0 && settings.dt.is_finite()) {
             return Err(ShellError::TimeStep { dt: settings.dt });
         }
@@ -377,6 +385,7 @@ impl Simulation {
             pinned,
             handles,
             obstacles,
+            obstacle_motions,
             settings,
             time: 0.0,
             steps: 0,
@@ -391,15 +400,45 @@ impl Simulation {
         self.x.chunks(3).map(|p| [p[0], p[1], p[2]]).collect()
     }
 
-    /// Obstacle penalty energy, gradient and (PSD) Hessian block of one vertex.
-    fn obstacle_terms(&self, v: usize, p: [f64; 3]) -> (f64, [f64; 3], [[f64; 3]; 3]) {
+    /// The proximity of `p` to obstacle i placed as at time t.
+    fn obstacle_proximity(&self, i: usize, p: [f64; 3], t: f64) -> Proximity {
+        let o = self.obstacle_motions[i].position(t);
+        let shape = &self.obstacles[i];
+        if o == [0.0; 3] {
+            return shape.proximity(p);
+        }
+        let local = std::array::from_fn(|c| p[c] - o[c]);
+        shape.feature(local).translated(o).proximity(p)
+    }
+
+    /// Triangle meshes of the obstacles' surfaces placed as at the current time, for pictures (planes have
+    /// none).
+    pub fn obstacle_surfaces(&self) -> Vec<super::mesh::Surface> {
+        self.obstacles
+            .iter()
+            .zip(&self.obstacle_motions)
+            .filter_map(|(o, m)| {
+                let (x, t) = o.surface()?;
+                let d = m.position(self.time);
+                Some((
+                    x.iter()
+                        .map(|p| std::array::from_fn(|c| p[c] + d[c]))
+                        .collect(),
+                    t,
+                ))
+            })
+            .collect()
+    }
+
+    /// Obstacle penalty energy, gradient and (PSD) Hessian block of one vertex at p, obstacles as at time t.
+    fn obstacle_terms(&self, v: usize, p: [f64; 3], t: f64) -> (f64, [f64; 3], [[f64; 3]; 3]) {
         let mut e = 0.0;
         let mut g = [0.0; 3];
         let mut h = [[0.0; 3]; 3];
         let s = &self.settings;
-        for o in &self.obstacles {
+        for i in 0..self.obstacles.len() {
             let (eo, go, ho) = obstacle::penalty(
-                &o.proximity(p),
+                &self.obstacle_proximity(i, p, t),
                 self.mass[v],
                 s.contact_stiffness,
                 s.thickness,
@@ -608,9 +647,10 @@ impl Simulation {
             }
             vec![]
         };
-        let lagged = self.lagged(&xn, h)?;
+        let lagged = self.lagged(&xn, h, t1)?;
         let tg = Target {
             h,
+            time: t1,
             xt: xt.clone(),
             xn,
             springs,
@@ -720,25 +760,45 @@ impl Simulation {
         None
     }
 
-    /// The force each handle exerts on the cloth: with hard constraints the sum of the full gradient of Φ over
-    /// its vertices, with springs the sum of the spring forces k (p_v − x_v) at the current state.
-    fn handle_forces(&self, g_full: &[f64]) -> Vec<(String, [f64; 3])> {
+    /// The names of the held sets in the order of [`StepReport::handle_forces`]: the handles, then `pinned`
+    /// when there are pinned vertices.
+    pub fn held_set_names(&self) -> impl Iterator<Item = &str> {
         self.handles
             .iter()
-            .map(|hd| {
-                let mut f = [0.0; 3];
-                let o = hd.offset(self.time);
-                for &v in &hd.vertices {
-                    for c in 0..3 {
-                        f[c] += match self.settings.handle_stiffness {
-                            None => g_full[3 * v + c],
-                            Some(k) => k * (self.x0[3 * v + c] + o[c] - self.x[3 * v + c]),
-                        };
-                    }
+            .map(|h| h.name.as_str())
+            .chain((!self.pinned.is_empty()).then_some("pinned"))
+    }
+
+    /// The force each held set exerts on the cloth, each handle under its name and the pinned vertices as
+    /// `pinned` (when there are any): with hard constraints the sum of the full gradient of Φ over its
+    /// vertices, with springs the sum of the spring forces k (p_v − x_v) at the current state.
+    fn handle_forces(&self, g_full: &[f64]) -> Vec<(String, [f64; 3])> {
+        let reaction = |vertices: &[usize], o: [f64; 3]| {
+            let mut f = [0.0; 3];
+            for &v in vertices {
+                for c in 0..3 {
+                    f[c] += match self.settings.handle_stiffness {
+                        None => g_full[3 * v + c],
+                        Some(k) => k * (self.x0[3 * v + c] + o[c] - self.x[3 * v + c]),
+                    };
                 }
-                (hd.name.clone(), f)
+            }
+            f
+        };
+        let mut out: Vec<(String, [f64; 3])> = self
+            .handles
+            .iter()
+            .map(|hd| {
+                (
+                    hd.name.clone(),
+                    reaction(&hd.vertices, hd.offset(self.time)),
+                )
             })
-            .collect()
+            .collect();
+        if !self.pinned.is_empty() {
+            out.push(("pinned".to_string(), reaction(&self.pinned, [0.0; 3])));
+        }
+        out
     }
 
     /// Kinetic energy, gravitational potential energy relative to the initial state and obstacle energy of the
@@ -755,7 +815,7 @@ impl Simulation {
                 ek += 0.5 * m * self.v[3 * v + c].powi(2);
                 eg -= m * s.gravity[c] * (p[c] - self.x0[3 * v + c]);
             }
-            eo += self.obstacle_terms(v, p).0;
+            eo += self.obstacle_terms(v, p, self.time).0;
         }
         (ek, eg, eo)
     }

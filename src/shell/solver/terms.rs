@@ -29,13 +29,15 @@ pub(super) struct Lagged {
     damping_values: Vec<f64>,
     /// per stencil, its face's drag data (empty without wind)
     drag: Vec<Option<DragFace>>,
-    /// vertices in an obstacle layer with their frozen normal and normal force (empty without friction)
-    friction: Vec<FrictionContact>,
+    /// vertices in an obstacle layer with their frozen normal and normal force, and the obstacle's translation
+    /// over the substep (empty without friction)
+    friction: Vec<(FrictionContact, [f64; 3])>,
 }
 
 impl Simulation {
-    /// The lagged data of a substep of length h starting at `xn` (damping and drag only in dynamic mode).
-    pub(super) fn lagged(&self, xn: &[f64], h: f64) -> Result<Lagged, ShellError> {
+    /// The lagged data of a substep of length h starting at `xn` and ending at `t1` (damping and drag only in
+    /// dynamic mode).
+    pub(super) fn lagged(&self, xn: &[f64], h: f64, t1: f64) -> Result<Lagged, ShellError> {
         let s = &self.settings;
         let dynamic = !s.quasi_static;
         let mut damping = std::sync::Arc::new(Vec::new());
@@ -100,15 +102,19 @@ impl Simulation {
                     continue;
                 }
                 let p = [xn[3 * v], xn[3 * v + 1], xn[3 * v + 2]];
-                for o in &self.obstacles {
-                    let pr = o.proximity(p);
+                for (i, motion) in self.obstacle_motions.iter().enumerate() {
+                    let pr = self.obstacle_proximity(i, p, self.time);
                     let pen = s.thickness - pr.d;
                     if pen > 0.0 {
-                        friction.push(FrictionContact {
-                            vertex: v,
-                            n: pr.n,
-                            lambda: self.mass[v] * s.contact_stiffness * pen * pen,
-                        });
+                        let (o0, o1) = (motion.position(self.time), motion.position(t1));
+                        friction.push((
+                            FrictionContact {
+                                vertex: v,
+                                n: pr.n,
+                                lambda: self.mass[v] * s.contact_stiffness * pen * pen,
+                            },
+                            std::array::from_fn(|c| o1[c] - o0[c]),
+                        ));
                     }
                 }
             }
@@ -127,7 +133,7 @@ impl Simulation {
         let h = tg.h;
         let m = self.mass[v];
         let p = [x[3 * v], x[3 * v + 1], x[3 * v + 2]];
-        let (mut e, mut g, mut blk) = self.obstacle_terms(v, p);
+        let (mut e, mut g, mut blk) = self.obstacle_terms(v, p, tg.time);
         for c in 0..3 {
             let i = 3 * v + c;
             let dn = x[i] - tg.xn[i];
@@ -164,9 +170,9 @@ impl Simulation {
     fn sparse_terms(&self, x: &[f64], tg: &Target, mut emit: impl FnMut(Term)) {
         let s = &self.settings;
         let eps = s.friction_velocity * tg.h;
-        for fc in &tg.lagged.friction {
+        for (fc, moved) in &tg.lagged.friction {
             let v = fc.vertex;
-            let delta = std::array::from_fn(|c| x[3 * v + c] - tg.xn[3 * v + c]);
+            let delta = std::array::from_fn(|c| x[3 * v + c] - tg.xn[3 * v + c] - moved[c]);
             let (e, g, hb) = obstacle::friction(fc, s.friction, eps, delta);
             emit(Term::Vertex(e, v, g, hb));
         }
