@@ -75,7 +75,7 @@ impl Ctx<'_> {
                 None => self.warn(
                     v.line,
                     &full,
-                    "ignored: not an ARCSim key this converter knows (see README-arcsim.md)",
+                    "ignored: not an ARCSim key this converter knows (docs/arcsim.md lists them)",
                 ),
             }
         }
