@@ -1,5 +1,5 @@
-//! From a parsed ARCSim scene to our [`Scene`] (issue 18, Deliver 1; the mapping of every key is listed in
-//! `README-arcsim.md`).
+//! From a parsed ARCSim scene to our [`Scene`] (the mapping of every key is listed in the guide,
+//! `docs/arcsim.md`).
 
 use super::handlebar::{Handlebar, SIDES};
 use super::json::Node;

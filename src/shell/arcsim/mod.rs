@@ -1,8 +1,8 @@
-//! ARCSim-HYLC scene files (issue 18, Deliver 1: "`hylc simulate path/to/arcsim_scene.json` recognises an
-//! ARCSim scene (comments allowed) and runs it; the same scene can be converted once to our scene JSON").
+//! ARCSim-HYLC scene files: `hylc simulate path/to/arcsim_scene.json` recognises an ARCSim scene (comments
+//! allowed) and runs it; the same scene can be converted once to our scene JSON (`--print`).
 //!
 //! An ARCSim scene is read with [`json`] (JSON with `//` and `/* */` comments, every value with its line) and
-//! converted to a [`Scene`] plus one-line warnings for the keys it does not use. The mapping (`README-arcsim.md`
+//! converted to a [`Scene`] plus one-line warnings for the keys it does not use. The mapping (`docs/arcsim.md`
 //! lists it in full):
 //! - `hylc.material` → `material`, `hylc.only1D` → `model.only_1d`; `psd` is `psi` as in our built-ins;
 //! - `cloths[0].mesh` + `transform` → `mesh: {"obj": ..}` (rest layout = scaled OBJ x, y; initial state = the
