@@ -203,6 +203,14 @@ fn physical_parameters_out_of_range_are_errors_naming_the_field() {
             }),
         ),
         (
+            "field `solver.time_tol`: must be a positive length (m) or null, got 0",
+            Box::new(|s| s.solver.time_tol = Some(0.0)),
+        ),
+        (
+            "field `solver.time_tol`: must be a positive length (m) or null, got NaN",
+            Box::new(|s| s.solver.time_tol = Some(f64::NAN)),
+        ),
+        (
             "field `fabric_angle_deg`",
             Box::new(|s| s.fabric_angle_deg = f64::NAN),
         ),

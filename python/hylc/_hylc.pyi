@@ -113,4 +113,5 @@ def simulate(
     duration: Optional[float] = None,
     dt: Optional[float] = None,
     edge: Optional[float] = None,
+    time_tol: Optional[float] = None,
 ) -> dict[str, Any]: ...

@@ -19,6 +19,8 @@ fn log_columns<'py>(py: Python<'py>, log: &[StepReport], d: &Bound<'py, PyDict>)
     d.set_item("newton", col(&|r| r.newton as f64))?;
     d.set_item("substeps", col(&|r| r.substeps as f64))?;
     d.set_item("dt_min", col(&|r| r.dt_min))?;
+    d.set_item("rejected", col(&|r| r.rejected as f64))?;
+    d.set_item("error_estimate", col(&|r| r.error_estimate))?;
     d.set_item("residual", col(&|r| r.residual))?;
     d.set_item("energy_elastic", col(&|r| r.energy_elastic))?;
     d.set_item("energy_kinetic", col(&|r| r.energy_kinetic))?;
@@ -51,9 +53,10 @@ fn log_columns<'py>(py: Python<'py>, log: &[StepReport], d: &Bound<'py, PyDict>)
 /// `log.jsonl` are written there as well. Returns a dict: the step log as (steps,) arrays (`step`, `time`,
 /// `newton`, `residual`, energies, …; `strain_*` (steps, 6); `handle_forces` name → (steps, 3)), `positions`
 /// (vertices, 3) and `triangles` (triangles, 3) of the final state, and `summary` (steps, Newton iterations,
-/// wall time). A step that fails even at the smallest substep raises `SimulationError`.
+/// wall time). `time_tol` (m) chooses substeps by their estimated error, as the scene's `solver.time_tol`. A step
+/// that fails even at the smallest substep raises `SimulationError`.
 #[pyfunction]
-#[pyo3(signature = (scene, out=None, material=None, duration=None, dt=None, edge=None))]
+#[pyo3(signature = (scene, out=None, material=None, duration=None, dt=None, edge=None, time_tol=None))]
 pub fn simulate<'py>(
     py: Python<'py>,
     scene: &str,
@@ -62,12 +65,14 @@ pub fn simulate<'py>(
     duration: Option<f64>,
     dt: Option<f64>,
     edge: Option<f64>,
+    time_tol: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let ov = Overrides {
         material,
         duration,
         dt,
         edge,
+        time_tol,
         ..Default::default()
     };
     let path = std::path::Path::new(scene);

@@ -110,6 +110,9 @@ pub enum ShellError {
     /// An obstacle mesh that cannot be used (not a manifold, consistently oriented triangle mesh).
     #[error("{file}: {problem}")]
     ObstacleMesh { file: String, problem: String },
+    /// A time tolerance that is not a positive finite length.
+    #[error("time tolerance {tol}: expected a positive finite length (m)")]
+    TimeTolerance { tol: f64 },
     /// More obstacle motions than obstacles were given to a simulation.
     #[error("{motions} obstacle motions for {obstacles} obstacles (one per obstacle at most)")]
     ObstacleMotions { motions: usize, obstacles: usize },

@@ -14,6 +14,8 @@ pub struct Overrides {
     pub material: Option<String>,
     pub duration: Option<f64>,
     pub dt: Option<f64>,
+    /// The largest estimated local error of a substep (m), `solver.time_tol`.
+    pub time_tol: Option<f64>,
     /// The edge length of a rectangle mesh.
     pub edge: Option<f64>,
     pub psd: Option<Psd>,
@@ -61,6 +63,14 @@ pub fn prepare_noted(
             )));
         }
         scene.dt = dt;
+    }
+    if let Some(tol) = ov.time_tol {
+        if !(tol.is_finite() && tol > 0.0) {
+            return Err(WorkflowError::Input(format!(
+                "--time-tol {tol}: expected a positive length (m)"
+            )));
+        }
+        scene.solver.time_tol = Some(tol);
     }
     if let Some(e) = ov.edge {
         match &mut scene.mesh {

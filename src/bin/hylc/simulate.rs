@@ -29,9 +29,13 @@ pub struct Args {
     /// simulated time (s) instead of the scene's
     #[arg(long)]
     duration: Option<f64>,
-    /// time step (s) instead of the scene's
+    /// time step (s) instead of the scene's: one frame (OBJ and log line) per step
     #[arg(long)]
     dt: Option<f64>,
+    /// choose substeps by accuracy: the largest estimated local error of a substep, in metres (the scene's
+    /// solver.time_tol; by default substeps shorten only when Newton fails)
+    #[arg(long, value_name = "METRES")]
+    time_tol: Option<f64>,
     /// edge length (m) of a rectangle mesh instead of the scene's
     #[arg(long)]
     edge: Option<f64>,
@@ -79,6 +83,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         material: a.material,
         duration: a.duration,
         dt: a.dt,
+        time_tol: a.time_tol,
         edge: a.edge,
         psd: a.psd.map(Into::into),
         no_bending: a.no_bending,

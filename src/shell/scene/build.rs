@@ -75,6 +75,7 @@ impl Scene {
             wind: self.wind,
             handle_stiffness: self.handle_stiffness,
             max_halvings: self.solver.max_halvings,
+            time_tol: self.solver.time_tol,
         };
         let obstacles = self.obstacles(file, dir)?;
         let sim = Simulation::new(

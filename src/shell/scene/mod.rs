@@ -20,7 +20,8 @@
 //!             "fold_barrier": {"angle": 2.5, "stiffness": 1.0},    // null: none (`super::fold`)
 //!             "collapse_barrier": {"area": 0.2, "stiffness": 1.0}}, // null: none (`super::fold`)
 //!   "psd": "full",                               // "full" (18×18), "psi" (6×6), "none" (diagonal shift)
-//!   "solver": {"force_tol": 1e-6, "max_newton": 50, "exact_first": true, "max_halvings": 6},
+//!   "solver": {"force_tol": 1e-6, "max_newton": 50, "exact_first": true, "max_halvings": 6,
+//!              "time_tol": null},                // a length (m): substeps chosen by their estimated error
 //!   "pins": [{"near": {"point": [0, 0], "radius": 0.01}}],
 //!   "handles": [{"name": "left", "select": {"box": {"min": [0, 0.05], "max": [0.021, 0.25]}},
 //!                "keyframes": [[0, [0, 0, 0]], [0.25, [-0.02, 0, 0]]],
@@ -299,6 +300,10 @@ pub struct SolverSpec {
     /// a step whose Newton iterations do not converge is retried with the time step halved, at most this many
     /// times (6: down to 1/64 of it)
     pub max_halvings: u32,
+    /// the largest estimated local error of a substep (m), `None` (the default): substeps shorten only when
+    /// Newton fails (`super::solver`, "Accuracy")
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_tol: Option<f64>,
 }
 
 impl Default for SolverSpec {
@@ -309,6 +314,7 @@ impl Default for SolverSpec {
             max_newton: s.max_newton,
             exact_first: s.exact_first,
             max_halvings: s.max_halvings,
+            time_tol: s.time_tol,
         }
     }
 }

@@ -161,6 +161,14 @@ impl Scene {
                 ),
             );
         }
+        if let Some(tol) = self.solver.time_tol {
+            if !(tol > 0.0 && tol.is_finite()) {
+                return bad(
+                    "solver.time_tol",
+                    format!("must be a positive length (m) or null, got {tol}"),
+                );
+            }
+        }
         let c = &self.contact;
         if !(c.friction_velocity > 0.0 && c.friction_velocity.is_finite()) {
             return bad(

@@ -109,6 +109,9 @@ pub struct Settings {
     pub handle_stiffness: Option<f64>,
     /// a step is retried with h halved at most this many times
     pub max_halvings: u32,
+    /// `Some(τ)`: substep lengths chosen so that the estimated local error of each substep is at most τ (m)
+    /// (module documentation, "Accuracy"); `None`: substeps only shorten when Newton fails
+    pub time_tol: Option<f64>,
 }
 
 impl Default for Settings {
@@ -129,6 +132,7 @@ impl Default for Settings {
             wind: Wind::default(),
             handle_stiffness: None,
             max_halvings: 6,
+            time_tol: None,
         }
     }
 }
@@ -144,6 +148,11 @@ pub struct StepReport {
     pub substeps: usize,
     /// the smallest substep used (s)
     pub dt_min: f64,
+    /// substeps rejected because their estimated error exceeded `time_tol`
+    pub rejected: usize,
+    /// the largest estimated local error of the step's accepted substeps, maxᵥ ½ |xᵥ − x̃ᵥ| (m; 0 in
+    /// quasi-static mode)
+    pub error_estimate: f64,
     /// largest residual force on a free vertex at the end (N)
     pub residual: f64,
     /// always true: a substep that does not converge is retried with h halved, and a step that cannot converge
@@ -258,6 +267,8 @@ pub struct Simulation {
     level: u32,
     /// converged substeps in a row at the current level
     streak: u32,
+    /// the next substep length under `time_tol` (s)
+    h_next: f64,
     /// the local PSD Hessians at the state `.0` (the last converged assembly), which the next substep's damping
     /// reuses instead of assembling them again
     damping_cache: Option<DampingCache>,
@@ -333,6 +344,12 @@ impl Simulation {
         if !(settings.dt > 0.0 && settings.dt.is_finite()) {
             return Err(ShellError::TimeStep { dt: settings.dt });
         }
+        if let Some(tol) = settings.time_tol {
+            if !(tol > 0.0 && tol.is_finite()) {
+                return Err(ShellError::TimeTolerance { tol });
+            }
+        }
+        let settings_dt = settings.dt;
         let mut constrained = vec![false; n];
         for &v in pinned
             .iter()
@@ -391,6 +408,7 @@ impl Simulation {
             steps: 0,
             level: 0,
             streak: 0,
+            h_next: settings_dt,
             damping_cache: None,
         })
     }
@@ -461,21 +479,57 @@ impl Simulation {
         Some(phi)
     }
 
-    /// Advance one step of length dt, in as many substeps as convergence needs (module documentation).
+    /// Advance one step of length dt, in as many substeps as convergence (and `time_tol`) needs (module
+    /// documentation).
     pub fn step(&mut self) -> Result<StepReport, ShellError> {
         let start = Instant::now();
         let dt = self.settings.dt;
         let t_end = self.time + dt;
         let step = self.steps + 1;
-        let (mut newton, mut substeps, mut dt_min) = (0, 0, dt);
-        let mut max_shift: f64 = 0.0;
+        let h_min = dt / f64::from(1u32 << self.settings.max_halvings);
+        let tol = self
+            .settings
+            .time_tol
+            .filter(|_| !self.settings.quasi_static);
+        let (mut newton, mut substeps, mut rejected, mut dt_min) = (0, 0, 0, dt);
+        let (mut max_shift, mut error_max): (f64, f64) = (0.0, 0.0);
         let mut last: Option<(Minimum, Target)> = None;
         // the step ends when the remaining time is a round-off fraction of dt
         while t_end - self.time > 1e-9 * dt {
-            let h = (dt / f64::from(1u32 << self.level)).min(t_end - self.time);
+            let remaining = t_end - self.time;
+            let wanted = match tol {
+                None => dt / f64::from(1u32 << self.level),
+                Some(_) => self.h_next,
+            };
+            // under `time_tol`, the last two substeps of a step share what is left instead of ending with a
+            // sliver (a very short substep after a long one makes the held vertices' inertia jump)
+            let h = if tol.is_some() && remaining > wanted && remaining < 2.0 * wanted {
+                0.5 * remaining
+            } else {
+                wanted.min(remaining)
+            };
             match self.substep(h, step)? {
                 Substep::Done(done) => {
                     let (mut m, tg) = *done;
+                    let err = self.substep_error(&m.x, &tg);
+                    if let Some(tol) = tol {
+                        let factor = 0.9 * (tol / err).sqrt();
+                        if err > tol && h > h_min * (1.0 + 1e-9) {
+                            // too inaccurate: retry shorter (the Newton work counts)
+                            newton += m.newton;
+                            rejected += 1;
+                            self.h_next = (h * factor.max(0.2)).max(h_min);
+                            continue;
+                        }
+                        let grown = h * factor.min(2.0);
+                        self.h_next = if h < wanted {
+                            grown.max(self.h_next)
+                        } else {
+                            grown
+                        }
+                        .clamp(h_min, dt);
+                    }
+                    error_max = error_max.max(err);
                     let local = std::mem::take(&mut m.asm.local);
                     self.damping_cache =
                         (!local.is_empty()).then(|| (m.x.clone(), std::sync::Arc::new(local)));
@@ -498,17 +552,25 @@ impl Simulation {
                 } => {
                     newton += n;
                     self.streak = 0;
-                    if self.level >= self.settings.max_halvings {
+                    let exhausted = match tol {
+                        None => self.level >= self.settings.max_halvings,
+                        Some(_) => h <= h_min * (1.0 + 1e-9),
+                    };
+                    if exhausted {
                         return Err(error.unwrap_or(ShellError::StepFailed {
                             step,
                             time: self.time,
-                            halvings: self.level,
+                            halvings: match tol {
+                                None => self.level,
+                                Some(_) => (dt / h).log2().round() as u32,
+                            },
                             dt: h,
                             residual,
                             newton: n,
                         }));
                     }
                     self.level += 1;
+                    self.h_next = (h / 2.0).max(h_min);
                 }
             }
         }
@@ -531,6 +593,8 @@ impl Simulation {
             newton,
             substeps,
             dt_min,
+            rejected,
+            error_estimate: error_max,
             residual: m.residual,
             converged: m.converged,
             energy_elastic: asm.energy,
@@ -545,6 +609,23 @@ impl Simulation {
             strain_p01: strain_quantile(&asm.z, 0.01),
             strain_p99: strain_quantile(&asm.z, 0.99),
         })
+    }
+
+    /// The estimated local error of a substep that ended at `x`: maxᵥ ½ |xᵥ − x̃ᵥ| over the free vertices (m;
+    /// module documentation, "Accuracy"), 0 in quasi-static mode.
+    fn substep_error(&self, x: &[f64], tg: &Target) -> f64 {
+        if self.settings.quasi_static {
+            return 0.0;
+        }
+        (0..self.pattern.n)
+            .filter(|&v| self.pattern.free[v].is_some())
+            .map(|v| {
+                let d2: f64 = (0..3)
+                    .map(|c| (x[3 * v + c] - tg.xt[3 * v + c]).powi(2))
+                    .sum();
+                0.5 * d2.sqrt()
+            })
+            .fold(0.0, f64::max)
     }
 
     /// One substep of length h from the current state (not yet accepted). Errors a smaller h may cure
