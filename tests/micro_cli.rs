@@ -161,7 +161,7 @@ fn retired_flags_are_refused_and_settings_carry_their_version() {
         "--interpolating-search",
         "--trust-region",
     ] {
-        for cmd in ["solve", "sample", "micro-grid"] {
+        for cmd in ["solve", "sample", "micro-grid", "identify"] {
             let err = cli_error(&[cmd, "plain", flag]);
             assert!(err.contains(flag), "{cmd} {flag}: {err}");
         }

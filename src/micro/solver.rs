@@ -626,8 +626,8 @@ impl<'p> NewtonRun<'p> {
         None
     }
 
-    /// 1. The energy, gradient and Hessian at `state` (exact Hessian, the stored frames) and the energy; an error
-    /// when Ψ̄ is not finite.
+    /// Step 1: the energy, gradient and Hessian at `state` (exact Hessian, the stored frames) and the energy; an
+    /// error when Ψ̄ is not finite.
     fn evaluate(&mut self, state: &MicroState) -> Result<(TileEval, f64), MicroError> {
         let ta = Instant::now();
         let ev = self
