@@ -34,7 +34,7 @@ pub struct Args {
     solver: SolverArgs,
     #[command(flatten)]
     yarn: YarnArgs,
-    /// no per-yarn slide constraints
+    /// no per-yarn slide constraints (an option of the original solver, kept to reproduce it)
     #[arg(long)]
     no_slide_constraints: bool,
     /// write the yarn centre lines as OBJ polylines (one file per strain when several)
