@@ -147,20 +147,30 @@ fn solve_quadrature_changes_the_contact_integral() {
     assert!((p1 - p8).abs() > 1e-9 * p8.abs(), "{p1} vs {p8}");
 }
 
-/// `--step-factor` (the displacement limit d_max = F · r · λ_min(Ī)) is a solver option of every command that
-/// solves: a bad value is one line naming the flag, and a sample file's settings record the value it used.
+/// The flags of the retired micro-solver rules (`docs/notes/retired-micro-solver-rules.md`) are gone from every
+/// command that solves (one line naming the flag), and a sample file's settings say their version and the step
+/// rule.
 #[test]
-fn step_factor_is_checked_and_recorded() {
-    for bad in ["0", "-1", "nan", "inf", "x"] {
-        for cmd in ["solve", "sample", "micro-grid"] {
-            let err = cli_error(&[cmd, "plain", "--step-factor", bad]);
-            assert!(
-                err.contains("--step-factor"),
-                "{cmd} --step-factor {bad}: {err}"
-            );
+fn retired_flags_are_refused_and_settings_carry_their_version() {
+    for flag in [
+        "--step-factor",
+        "--projected-steps",
+        "--keep-shift",
+        "--psd-stencils",
+        "--exact-backoff",
+        "--interpolating-search",
+        "--trust-region",
+    ] {
+        for cmd in ["solve", "sample", "micro-grid", "identify"] {
+            let err = cli_error(&[cmd, "plain", flag]);
+            assert!(err.contains(flag), "{cmd} {flag}: {err}");
         }
     }
-    let dir = std::env::temp_dir().join("hylc_micro_cli_step_factor");
+    let err = cli_error(&["solve", "plain", "--backtracking", "0.5"]);
+    assert!(err.contains("--backtracking"), "{err}");
+    let err = cli_error(&["sample", "plain", "--predictor", "tangent"]);
+    assert!(err.contains("tangent"), "{err}");
+    let dir = std::env::temp_dir().join("hylc_micro_cli_settings_version");
     std::fs::create_dir_all(&dir).unwrap();
     let plan = dir.join("plan.json");
     let mut p = hylc::sample::Plan::reduced();
@@ -169,25 +179,27 @@ fn step_factor_is_checked_and_recorded() {
     p.count_2d = 0;
     p.pairs = vec![];
     std::fs::write(&plan, p.canonical_json()).unwrap();
-    let settings = |factor: &str| -> serde_json::Value {
-        let out_file = dir.join(format!("s{factor}.jsonl"));
+    let settings = |extra: &[&str]| -> serde_json::Value {
+        let out_file = dir.join(format!("s{}.jsonl", extra.len()));
         std::fs::remove_file(&out_file).ok();
-        cli_ok(&[
+        let mut args = vec![
             "sample",
             "plain",
             "--plan",
             plan.to_str().unwrap(),
             "--out",
             out_file.to_str().unwrap(),
-            "--step-factor",
-            factor,
-        ]);
+        ];
+        args.extend_from_slice(extra);
+        cli_ok(&args);
         let meta = out_file.with_extension("meta.json");
         serde_json::from_str(&std::fs::read_to_string(meta).unwrap()).unwrap()
     };
-    let (one, three) = (settings("1"), settings("3"));
-    assert_eq!(one["solver"]["step_factor"].as_f64(), Some(1.0));
-    assert_eq!(three["solver"]["step_factor"].as_f64(), Some(3.0));
-    assert_ne!(one["problem"], three["problem"]);
+    let (default, design) = (settings(&[]), settings(&["--no-inertia"]));
+    assert_eq!(default["solver"]["version"].as_u64(), Some(2));
+    assert_eq!(default["solver"]["step_rule"].as_str(), Some("inertia"));
+    assert_eq!(design["solver"]["step_rule"].as_str(), Some("shift"));
+    assert!(default["solver"].get("step_factor").is_none());
+    assert_ne!(default["problem"], design["problem"]);
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -1,8 +1,8 @@
-//! Inertia-controlled Newton steps (`SolverOptions::inertia`, the default; issue 20; `03-homogenization.md`,
+//! Inertia-controlled Newton steps (`StepRule::Inertia`, the default; issue 20; `03-homogenization.md`,
 //! section 3), on the generated plain weave (no external data needed).
 
 use hylc::generate::default_pattern;
-use hylc::micro::{MacroStrain, MicroProblem, Solution, SolverOptions, Status};
+use hylc::micro::{MacroStrain, MicroProblem, Solution, SolverOptions, Status, StepRule};
 use hylc::rod::YarnMaterial;
 
 fn solver(options: SolverOptions) -> MicroProblem {
@@ -15,19 +15,13 @@ fn solver(options: SolverOptions) -> MicroProblem {
 
 fn problem(inertia: bool) -> MicroProblem {
     solver(SolverOptions {
-        inertia,
+        step_rule: if inertia {
+            StepRule::Inertia
+        } else {
+            StepRule::Shift
+        },
         ..Default::default()
     })
-}
-
-/// An option that is off by default is written to the settings JSON only while on (`on` = the defaults with it
-/// set), and the JSON reads back.
-fn written_only_while_on(on: SolverOptions, key: &str) {
-    let off = serde_json::to_string(&SolverOptions::default()).unwrap();
-    assert!(!off.contains(key), "{off}");
-    let json = serde_json::to_string(&on).unwrap();
-    assert!(json.contains(&format!("\"{key}\":true")), "{json}");
-    assert_eq!(serde_json::from_str::<SolverOptions>(&json).unwrap(), on);
 }
 
 /// Both rules converge at `z` to the same Ψ̄ (1e-8 relative).
@@ -72,68 +66,4 @@ fn inertia_steps_reach_the_same_equilibria_in_fewer_steps() {
     }
     eprintln!("steps: design {steps_design}, inertia {steps_inertia} ({exact} exact)");
     assert!(steps_inertia <= steps_design);
-}
-
-/// The option is on by default and written to the settings JSON only while on, so that a settings record made
-/// before it (no key) reads as off, the rule it was made with, and sample files made before it keep their problem
-/// hash with `--no-inertia`.
-#[test]
-fn inertia_is_the_default_and_an_old_settings_record_reads_as_off() {
-    let on = SolverOptions::default();
-    assert!(on.inertia && on.inertia_steps());
-    let json = serde_json::to_string(&on).unwrap();
-    assert!(json.contains("\"inertia\":true"), "{json}");
-    let off = SolverOptions {
-        inertia: false,
-        ..Default::default()
-    };
-    let json_off = serde_json::to_string(&off).unwrap();
-    assert!(!json_off.contains("inertia"), "{json_off}");
-    let back: SolverOptions = serde_json::from_str(&json).unwrap();
-    assert_eq!(back, on);
-    let back_off: SolverOptions = serde_json::from_str(&json_off).unwrap();
-    assert_eq!(back_off, off);
-}
-
-/// `SolverOptions::exact_backoff`: on a compressed, bent plain weave solved cold (a solve whose exact attempts are
-/// refused in runs) the skipped attempts change the path but not the equilibrium (Ψ̄ to 1e-8); the option is
-/// off by default and written to the settings JSON only while on.
-#[test]
-fn exact_backoff_changes_the_path_not_the_equilibrium() {
-    let z = MacroStrain::new(-0.4, 0.0, 0.0, 0.0, 150.0);
-    let every_step = problem(true).solve(&z, None).unwrap();
-    let on = SolverOptions {
-        exact_backoff: true,
-        ..Default::default()
-    };
-    let backoff = solver(on.clone()).solve(&z, None).unwrap();
-    same_equilibrium(&z, &every_step, &backoff);
-    assert_ne!(
-        (every_step.steps, every_step.exact_steps),
-        (backoff.steps, backoff.exact_steps),
-        "the backoff skipped no exact attempt"
-    );
-    assert!(!SolverOptions::default().exact_backoff);
-    written_only_while_on(on, "exact_backoff");
-}
-
-/// `SolverOptions::interpolating_search`: on the compressed, bent plain weave solved cold (a solve that
-/// backtracks) the interpolated trial steps change the path but not the equilibrium (Ψ̄ to 1e-8); the option is
-/// off by default and written to the settings JSON only while on.
-#[test]
-fn interpolating_search_changes_the_path_not_the_equilibrium() {
-    let z = MacroStrain::new(-0.4, 0.0, 0.0, 0.0, 150.0);
-    let factor = problem(true).solve(&z, None).unwrap();
-    let on = SolverOptions {
-        interpolating_search: true,
-        ..Default::default()
-    };
-    let interpolated = solver(on.clone()).solve(&z, None).unwrap();
-    same_equilibrium(&z, &factor, &interpolated);
-    assert_ne!(
-        factor.steps, interpolated.steps,
-        "the interpolated trial steps changed nothing"
-    );
-    assert!(!SolverOptions::default().interpolating_search);
-    written_only_while_on(on, "interpolating_search");
 }

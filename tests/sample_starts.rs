@@ -118,7 +118,7 @@ fn warm_and_cold_resumed_and_sharded_give_the_same_records() {
     std::fs::remove_dir_all(&d).ok();
 }
 
-/// The plain weave under the design's shift rule (`SolverOptions::inertia` off): there the tiny plan has samples
+/// The plain weave under the design's shift rule (`StepRule::Shift`): there the tiny plan has samples
 /// in mid-chain whose warm and cold starts disagree, which this test needs (with the inertia rule, the default,
 /// no disagreement of the tiny plan is both above the default threshold and continued by a later step, so no
 /// reversed start is made).
@@ -127,7 +127,7 @@ fn design_rule_problem() -> hylc::micro::MicroProblem {
         hylc::generate::default_pattern("plain").unwrap(),
         &hylc::rod::YarnMaterial::default(),
         hylc::micro::SolverOptions {
-            inertia: false,
+            step_rule: hylc::micro::StepRule::Shift,
             ..Default::default()
         },
     )

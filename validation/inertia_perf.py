@@ -12,7 +12,7 @@ usage: validation/inertia_perf.py [--hylc BIN] [--shards 0-4] [--extra "--crossi
                                   [--base FLAGS] [--new FLAGS] [--labels A,B] [PATTERN ...]
   shards of the reduced plan: 0-4 are the 1D chains (s_x, s_a, s_y, II00, II11), 5-13 the 2D grids
   --base / --new: the two variants' own flags (default `--no-inertia` / none: design rule against inertia);
-  e.g. --base "" --new "--step-factor 3" --tag _sf3 --labels "step factor 1,step factor 3"
+  e.g. --base "" --new "--crossings reject" --tag _cr --labels "guard off,guard reject"
 """
 import argparse
 import json

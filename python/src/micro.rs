@@ -10,7 +10,7 @@ use hylc::micro::envelope::{
 };
 use hylc::micro::sensitivity::equilibrium_sensitivities;
 use hylc::micro::solver::world_positions;
-use hylc::micro::{MacroStrain, MicroProblem, Solution, SolverOptions};
+use hylc::micro::{MacroStrain, MicroProblem, Solution, SolverOptions, StepRule};
 use hylc::strain::StrainComponent;
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
@@ -89,7 +89,11 @@ impl PyMicroProblem {
             tolerance,
             max_steps,
             time_limit,
-            inertia,
+            step_rule: if inertia {
+                StepRule::Inertia
+            } else {
+                StepRule::Shift
+            },
             ..Default::default()
         };
         Ok(PyMicroProblem {

@@ -95,8 +95,6 @@ pub struct KktSolver {
     values: Vec<f64>,
     /// factorisation and solve workspace for up to this many right-hand sides (reset with the pattern)
     scratch: Option<(usize, MemBuffer)>,
-    /// `values` holds the factor of the stored H + μI of the last successful factorisation
-    factored: bool,
     /// Number of symbolic analyses performed (for the performance report).
     pub analyses: usize,
     /// Which factorisation of H + μI is used (and so which shifted matrices are accepted).
@@ -160,7 +158,6 @@ impl KktSolver {
         n: usize,
         lower: &[(usize, usize, f64)],
     ) -> Result<(), FactorError> {
-        self.factored = false;
         if let Some(&(i, j, _)) = lower.iter().find(|t| t.0 >= n || t.1 > t.0) {
             return Err(FactorError::Other(format!(
                 "entry ({i}, {j}) is not in the lower triangle of a {n}×{n} matrix"
@@ -230,7 +227,6 @@ impl KktSolver {
         let lower = &pattern.lower;
         let cols = rhs_list.len().max(a.len()).max(1);
         let buf = workspace(&mut self.scratch, symbolic, cols);
-        self.factored = false;
         let llt = factorize_shifted(
             self.factorization,
             symbolic,
@@ -240,7 +236,6 @@ impl KktSolver {
             &mut self.values,
             buf,
         )?;
-        self.factored = true;
         let mut solver = ConstrainedSolve::new(llt, buf, lower.n, a)?;
         let mut out = solver.apply(&as_slices(rhs_list));
         for _ in 0..refine {
@@ -288,7 +283,6 @@ impl KktSolver {
         let n = lower.n;
         let cols = a.len().max(1);
         let buf = workspace(&mut self.scratch, symbolic, cols);
-        self.factored = false;
         let mut mu = mu.max(f64::MIN_POSITIVE);
         let mut tries = 0;
         while factorize_shifted(
@@ -317,173 +311,11 @@ impl KktSolver {
             &mut self.values,
             buf,
         )?;
-        self.factored = true;
         let mut solver = ConstrainedSolve::new(llt, buf, n, a)?;
         rhs_list
             .iter()
             .map(|b| projected_cg(&mut solver, lower, &self.matrix, b, tol, max_iter))
             .collect()
-    }
-
-    /// [`solve_projected`](Self::solve_projected) for one right-hand side with the factorisation of H + μI that
-    /// the last successful [`solve_shifted`](Self::solve_shifted) (or `solve_projected`) left, without
-    /// refactorising: the exact constrained Newton step where H + μI needed a larger shift than the floor to
-    /// factorise (H indefinite in the full space) but H may be positive definite on the null space of A. An
-    /// error when no factorisation is kept (none yet, or the matrix changed since), when a search direction has
-    /// pᵀHp ≤ 0, or after `max_iter` iterations.
-    pub fn solve_projected_kept(
-        &mut self,
-        b: &[f64],
-        a: &[Vec<f64>],
-        tol: f64,
-        max_iter: usize,
-    ) -> Result<Vec<f64>, FactorError> {
-        let (Some((pattern, symbolic)), true) = (self.pattern.as_ref(), self.factored) else {
-            return Err(FactorError::Other("no factorisation kept".into()));
-        };
-        let lower = &pattern.lower;
-        let buf = workspace(&mut self.scratch, symbolic, a.len().max(1));
-        let llt = Factor::kept(self.factorization, symbolic, &self.values);
-        let mut solver = ConstrainedSolve::new(llt, buf, lower.n, a)?;
-        projected_cg(&mut solver, lower, &self.matrix, b, tol, max_iter)
-    }
-}
-
-/// The outcome of [`KktSolver::trust_region_kept`]: an approximate minimiser of the quadratic model
-/// m(x) = bᵀx + ½ xᵀHx on the null space of A within a trust region.
-#[derive(Clone, Debug)]
-pub struct TrustRegionStep {
-    /// The step x (A x = 0).
-    pub step: Vec<f64>,
-    /// The model decrease −m(x) = −(bᵀx + ½ xᵀHx) with the unshifted H (≥ 0).
-    pub predicted: f64,
-    /// Conjugate-gradient iterations (H products).
-    pub iterations: usize,
-    /// The step ends on the trust-region boundary.
-    pub boundary: bool,
-    /// A search direction with pᵀHp ≤ 0 was met (negative curvature on the null space) and followed to the
-    /// boundary.
-    pub negative_curvature: bool,
-}
-
-/// The norm of a trust region for [`KktSolver::trust_region_kept`].
-pub trait TrustNorm {
-    /// ‖x‖.
-    fn norm(&self, x: &[f64]) -> f64;
-    /// The τ ≥ 0 with ‖x + τp‖ = `radius` for x inside the region (the first crossing).
-    fn to_boundary(&self, x: &[f64], p: &[f64], radius: f64) -> f64;
-}
-
-impl KktSolver {
-    /// The truncated (Steihaug–Toint) projected conjugate gradients on the model m(x) = bᵀx + ½ xᵀHx, A x = 0,
-    /// within the region `norm(x) ≤ radius` (`03-homogenization.md`, section 4: the step of a trust-region
-    /// Newton method in place of the shifted step and the backtracking), preconditioned by the factorisation of
-    /// H + μI that the last successful [`solve_shifted`](Self::solve_shifted) left (no new factorisation).
-    ///
-    /// The first iterate is the shifted KKT step −(H + μI)⁻¹_A b scaled to the model minimum along it; later
-    /// iterates tend to the exact constrained Newton step. When a direction has pᵀHp ≤ 0 (negative curvature on
-    /// the null space), the step follows it to the boundary; when an iterate leaves the region, the step stops
-    /// where its last direction crosses the boundary (`region` measures both). Stops when √(rᵀz) ≤ `tol` times its start value or after
-    /// `max_iter` iterations (the last iterate, still a model decrease). An error when no factorisation is kept.
-    pub fn trust_region_kept(
-        &mut self,
-        b: &[f64],
-        a: &[Vec<f64>],
-        radius: f64,
-        region: &impl TrustNorm,
-        tol: f64,
-        max_iter: usize,
-    ) -> Result<TrustRegionStep, FactorError> {
-        let (Some((pattern, symbolic)), true) = (self.pattern.as_ref(), self.factored) else {
-            return Err(FactorError::Other("no factorisation kept".into()));
-        };
-        let lower = &pattern.lower;
-        let n = lower.n;
-        let buf = workspace(&mut self.scratch, symbolic, a.len().max(1));
-        let llt = Factor::kept(self.factorization, symbolic, &self.values);
-        let mut solver = ConstrainedSolve::new(llt, buf, n, a)?;
-        let matrix = &self.matrix;
-        // the residual is kept on the null space of A (its part along the rows, the constraint force, does not
-        // change z but would leave rᵀz at round-off times that force: a floor of ~1e-8 on √(rᵀz))
-        let project = null_space_projector(a);
-        let mut x = vec![0.0; n];
-        let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
-        project(&mut r);
-        let mut z = solver.precondition(&r);
-        let mut p = z.clone();
-        let mut rz = dot(&r, &z);
-        let rz0 = rz;
-        let (mut iterations, mut boundary, mut negative_curvature) = (0, false, false);
-        while rz0 > 0.0 && iterations < max_iter {
-            let mut hp = vec![0.0; n];
-            lower.add_symmetric_product(matrix, &p, &mut hp);
-            iterations += 1;
-            let php = dot(&p, &hp);
-            if !php.is_finite() {
-                break;
-            }
-            if php <= 0.0 {
-                let tau = region.to_boundary(&x, &p, radius);
-                x.iter_mut().zip(&p).for_each(|(xi, pi)| *xi += tau * pi);
-                boundary = true;
-                negative_curvature = true;
-                break;
-            }
-            let alpha = rz / php;
-            let next: Vec<f64> = x.iter().zip(&p).map(|(xi, pi)| xi + alpha * pi).collect();
-            if region.norm(&next) >= radius {
-                let tau = region.to_boundary(&x, &p, radius).min(alpha);
-                x.iter_mut().zip(&p).for_each(|(xi, pi)| *xi += tau * pi);
-                boundary = true;
-                break;
-            }
-            x = next;
-            r.iter_mut().zip(&hp).for_each(|(ri, hi)| *ri -= alpha * hi);
-            project(&mut r);
-            z = solver.precondition(&r);
-            let rz_new = dot(&r, &z);
-            if rz_new <= tol * tol * rz0 {
-                break;
-            }
-            let beta = rz_new / rz;
-            p.iter_mut()
-                .zip(&z)
-                .for_each(|(pi, zi)| *pi = zi + beta * *pi);
-            rz = rz_new;
-        }
-        if x.iter().any(|v| !v.is_finite()) {
-            return Err(FactorError::NotPositiveDefinite);
-        }
-        let mut hx = vec![0.0; n];
-        lower.add_symmetric_product(matrix, &x, &mut hx);
-        let predicted = -(dot(b, &x) + 0.5 * dot(&x, &hx));
-        Ok(TrustRegionStep {
-            step: x,
-            predicted,
-            iterations,
-            boundary,
-            negative_curvature,
-        })
-    }
-}
-
-/// The Euclidean projection v ← v − Aᵀ (A Aᵀ)⁻¹ A v on the null space of the rows `a` (identity without rows, or
-/// when A Aᵀ is singular).
-fn null_space_projector(a: &[Vec<f64>]) -> impl Fn(&mut [f64]) + '_ {
-    let m = a.len();
-    let gram = DMatrix::from_fn(m, m, |i, j| dot(&a[i], &a[j]));
-    let chol = if m > 0 { gram.cholesky() } else { None };
-    move |v: &mut [f64]| {
-        let Some(c) = &chol else {
-            return;
-        };
-        let av = DVector::from_fn(m, |i, _| dot(&a[i], v));
-        let lambda = c.solve(&av);
-        for (k, row) in a.iter().enumerate() {
-            for (o, r) in v.iter_mut().zip(row) {
-                *o -= lambda[k] * r;
-            }
-        }
     }
 }
 
@@ -719,74 +551,6 @@ mod tests {
         assert!(solver
             .solve_projected(1e-10, std::slice::from_ref(&b), &a_wrong, 1e-14, 100)
             .is_err());
-    }
-
-    /// The truncated conjugate gradients of the trust-region step: with H positive definite on the null space and
-    /// a large radius they give the exact constrained Newton step (the dense KKT solve); with negative curvature
-    /// on the null space they end on the boundary with a model decrease; a small radius is respected.
-    #[test]
-    fn trust_region_step_follows_negative_curvature_to_the_boundary() {
-        let n = 5;
-        let (h, b) = indefinite_example();
-        let lower = lower_triplets(&h);
-        struct Euclid;
-        impl TrustNorm for Euclid {
-            fn norm(&self, x: &[f64]) -> f64 {
-                x.iter().map(|v| v * v).sum::<f64>().sqrt()
-            }
-            fn to_boundary(&self, x: &[f64], p: &[f64], radius: f64) -> f64 {
-                let (a, bb, c) = (
-                    p.iter().map(|v| v * v).sum::<f64>(),
-                    x.iter().zip(p).map(|(u, v)| u * v).sum::<f64>(),
-                    x.iter().map(|v| v * v).sum::<f64>() - radius * radius,
-                );
-                (-bb + (bb * bb - a * c).sqrt()) / a
-            }
-        }
-        let norm = |x: &[f64]| Euclid.norm(x);
-        let mut solver = KktSolver::default();
-        solver.set_matrix(n, &lower).unwrap();
-        // the preconditioner: H + 4 I factorises
-        let a = vec![vec![1.0, 0.0, 0.0, 0.0, 0.0]];
-        solver
-            .solve_shifted(4.0, std::slice::from_ref(&b), &a, 0)
-            .unwrap();
-        let exact = dense_kkt(&h, &a, &b);
-        let step = solver
-            .trust_region_kept(&b, &a, 1e3, &Euclid, 1e-14, 100)
-            .unwrap();
-        assert!(!step.boundary && !step.negative_curvature);
-        for i in 0..n {
-            assert!((step.step[i] - exact[i]).abs() < 1e-12, "{i}");
-        }
-        let small = solver
-            .trust_region_kept(&b, &a, 1e-2, &Euclid, 1e-14, 100)
-            .unwrap();
-        assert!(small.boundary);
-        assert!((norm(&small.step) - 1e-2).abs() < 1e-14);
-        assert!(small.predicted > 0.0 && small.predicted < step.predicted);
-        // A = e₄ᵀ leaves the negative direction e₀ in the null space
-        let a = vec![vec![0.0, 0.0, 0.0, 0.0, 1.0]];
-        solver
-            .solve_shifted(4.0, std::slice::from_ref(&b), &a, 0)
-            .unwrap();
-        let step = solver
-            .trust_region_kept(&b, &a, 2.0, &Euclid, 1e-14, 100)
-            .unwrap();
-        assert!(step.boundary && step.negative_curvature, "{step:?}");
-        assert!((norm(&step.step) - 2.0).abs() < 1e-12);
-        assert!(step.step[4].abs() < 1e-14);
-        let mut hx = vec![0.0; n];
-        for i in 0..n {
-            for j in 0..n {
-                hx[i] += h[(i, j)] * step.step[j];
-            }
-        }
-        let model: f64 = (0..n)
-            .map(|i| b[i] * step.step[i] + 0.5 * step.step[i] * hx[i])
-            .sum();
-        assert!((step.predicted + model).abs() < 1e-12);
-        assert!(step.predicted > 0.0);
     }
 
     /// A small SPD system with one constraint row against a dense solve of the full KKT matrix.

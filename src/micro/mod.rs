@@ -18,9 +18,9 @@ pub mod strain;
 pub mod surface;
 
 pub use elimination::Elimination;
+pub use options::SETTINGS_VERSION;
 pub use predict::Predictor;
 pub use solver::{
-    CrossingGuard, MicroError, MicroProblem, MicroState, PsdStencils, Solution, SolverOptions,
-    Status,
+    CrossingGuard, MicroError, MicroProblem, MicroState, Solution, SolverOptions, Status, StepRule,
 };
 pub use strain::{Family, MacroStrain, StrainError};

@@ -1,22 +1,15 @@
 //! Predictors for continuation along a chain of strains (issue 20, item 1): the start state of a solve at a
 //! strain next to one or two equilibria already found.
 //!
-//! - Secant ([`MicroProblem::predict`]): from two equilibria, y extrapolated linearly along the chain.
-//! - Tangent ([`MicroProblem::predict_tangent`]): from one equilibrium y*(z), the first-order change of the
-//!   equilibrium y*(z + Δz) ≈ y*(z) + (dy*/dz)·Δz by the implicit-function theorem (`03-homogenization.md`,
-//!   section 5): dy*·Δz = −H⁻¹ (∂(∇_y E)/∂z · Δz) on the constraint space, with one factorisation of the Newton
-//!   matrix H at the equilibrium ([`equilibrium_response`], as the envelope derivatives use it). The mixed term
-//!   ∂(∇_y E)/∂z · Δz is the difference of the reduced gradients at fixed unknowns between the target strain and
-//!   the equilibrium's own strain (the frames moved with the strain as in a warm start): this equals the
-//!   directional derivative to first order in Δz and keeps the change of the gradient with the strain at fixed
-//!   unknowns exactly, at one gradient evaluation per side.
+//! - Secant ([`MicroProblem::predict`]): from two equilibria, y extrapolated linearly along the chain; it returns
+//!   the state at the target strain with the frames transported to the predicted unknowns.
+//! - None: the previous equilibrium itself, moved to the new strain at fixed unknowns.
 //!
-//! Both return the state at the target strain with the frames transported to the predicted unknowns.
+//! A tangent predictor y* + (dy*/dz)·Δz was measured and not adopted (more steps, other branches; see
+//! `docs/notes/retired-micro-solver-rules.md`).
 
 use super::elimination::Elimination;
-use super::envelope::gradient_at;
-use super::sensitivity::equilibrium_response;
-use super::solver::{local, MicroError, MicroProblem, MicroState};
+use super::solver::{local, MicroProblem, MicroState};
 use super::strain::{MacroStrain, StrainError};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -28,8 +21,6 @@ pub enum Predictor {
     /// Linear extrapolation from the two previous equilibria ([`MicroProblem::predict`]).
     #[default]
     Secant,
-    /// y* + (dy*/dz)·Δz from the previous equilibrium ([`MicroProblem::predict_tangent`]).
-    Tangent,
     /// The previous equilibrium itself (moved to the new strain at fixed unknowns).
     None,
 }
@@ -74,33 +65,6 @@ impl MicroProblem {
             .zip(&prev.y)
             .map(|(a, b)| a + t * (a - b))
             .collect();
-        self.place(&mut state, y);
-        Ok(Some(state))
-    }
-
-    /// The tangent predictor (module docs): from the equilibrium `cur`, the state at `target` (same family) with
-    /// y = y* + (dy*/dz)·Δz. `None` when the families differ or `target` is `cur`'s own strain.
-    pub fn predict_tangent(
-        &self,
-        cur: &MicroState,
-        target: &MacroStrain,
-    ) -> Result<Option<MicroState>, MicroError> {
-        let family = target.validate_for_radius(self.pattern.radius)?;
-        if cur.family != family || cur.strain == *target {
-            return Ok(None);
-        }
-        let mut state = cur.clone();
-        self.move_to(&mut state, target)?;
-        let g1 = gradient_at(self, &state)?;
-        let g0 = gradient_at(self, cur)?;
-        let b: Vec<f64> = g1.iter().zip(&g0).map(|(a, b)| a - b).collect();
-        let dy = equilibrium_response(self, cur, &[b])?
-            .pop()
-            .expect("one right-hand side");
-        if dy.iter().any(|v| !v.is_finite()) {
-            return Ok(None);
-        }
-        let y: Vec<f64> = cur.y.iter().zip(&dy).map(|(a, d)| a + d).collect();
         self.place(&mut state, y);
         Ok(Some(state))
     }

@@ -7,21 +7,23 @@
 //! 2. tests convergence on ‖g‖_∞ ≤ tol·k_s and on the Newton decrement;
 //! 3. solves the KKT system of the null-space constraints with the unit scaling (r θ as the angular unknown),
 //!    growing μ ×10 while H + μI is not positive definite and shrinking it after successful steps; with
-//!    [`SolverOptions::inertia`] (the default) the exact step at μ's floor comes first wherever H is positive
+//!    [`StepRule::Inertia`] (the default) the exact step at μ's floor comes first wherever H is positive
 //!    definite on the constraint space, kept when the energy follows its quadratic model;
-//! 4. limits the largest vertex displacement to step_factor · r · λ_min(Ī);
+//! 4. limits the largest vertex displacement to r · λ_min(Ī);
 //! 5. backtracks y₀ + 0.1ⁱ δy, i = 0 … 10, transporting the stored frames to each trial (the stored frames are
 //!    only replaced when a trial is accepted), refreshing the contact candidates when vertices have moved by more
 //!    than half the broad-phase margin, and accepts the first lower energy.
 //!
-//! With [`SolverOptions::trust_region`] (off by default), steps 4–5 are a trust-region step instead: truncated
-//! conjugate gradients on the quadratic model, preconditioned by the factorisation of step 3.
+//! Step rules that were measured and not adopted (projected exact steps, a kept shift, per-stencil PSD projection,
+//! an exact-attempt backoff, an interpolating line search, a trust region, other displacement limits and
+//! backtracking factors, the tangent predictor) are described with their measurements in
+//! `docs/notes/retired-micro-solver-rules.md`.
 //!
 //! Every result carries its [`Status`]; [`Solution::psi`] refuses a non-converged one.
 
 use super::elimination::Elimination;
-use super::linear::{FactorError, Factorization, KktSolver, TrustNorm, TrustRegionStep};
-pub use super::options::{CrossingGuard, PsdStencils, SolverOptions, EXACT_BACKOFF_MAX};
+use super::linear::{FactorError, Factorization, KktSolver};
+pub use super::options::{CrossingGuard, SolverOptions, StepRule};
 use super::strain::{Family, MacroStrain, StrainError};
 use crate::contact::ccd::{net_crossings, Crossing};
 use crate::contact::ContactError;
@@ -136,7 +138,7 @@ pub struct Solution {
     pub area: f64,
     /// The largest regularisation μ used (N/m).
     pub max_mu: f64,
-    /// Of the steps, the exact constrained Newton steps of [`SolverOptions::inertia`] taken where the design's rule
+    /// Of the steps, the exact constrained Newton steps of [`StepRule::Inertia`] taken where the design's rule
     /// would have shifted μ above its floor.
     pub exact_steps: usize,
     /// Yarn crossings of the accepted steps ([`SolverOptions::crossings`] `count`; empty otherwise).
@@ -432,25 +434,12 @@ impl MicroProblem {
 
     /// Newton iterations from a state already at its strain (the steps of the module documentation).
     fn newton(&self, mut state: MicroState, t0: Instant) -> Result<Solution, MicroError> {
-        let opts = &self.options;
         let mut run = NewtonRun::start(self, &state, t0)?;
-        let inertia = opts.inertia_steps();
+        let inertia = self.options.inertia_steps();
         let mut roundoff = false;
         loop {
             // 1. energy, scaled gradient and Hessian at the iterate
-            let ta = Instant::now();
-            let ev = run
-                .tile
-                .evaluate(&state.frames, &state.y, Want::Hessian, &Terms::ALL)?;
-            run.timings.assembly += ta.elapsed().as_secs_f64();
-            let energy = ev.value();
-            if !(energy / run.area).is_finite() {
-                return Err(MicroError::NonFiniteEnergy {
-                    strain: state.strain,
-                    steps: run.steps,
-                    energy,
-                });
-            }
+            let (ev, energy) = run.evaluate(&state)?;
             let g = run.scaled_gradient(&ev);
             // 2. the force test uses the gradient projected on the constraint space (the constrained equilibrium
             // keeps a residual g = −Aᵀλ along the rows that are not exact symmetries, e.g. the yarn slides)
@@ -461,123 +450,60 @@ impl MicroProblem {
             if roundoff {
                 return Ok(run.finish(state, Status::Converged, &ev, gnorm));
             }
-            // 3. KKT step; with the inertia option the exact step first, kept when the energy follows its model
-            // (under the exact-step backoff, not while the last refusal's skipped steps last)
-            let attempt = inertia && run.skip_exact == 0;
-            let exact = if attempt {
-                run.exact_direction(&ev, &g)?
-            } else {
-                None
-            };
-            let attempted = attempt && run.mu > run.mu_floor;
-            if let Some(delta) = exact {
-                let decrement: f64 = g.iter().zip(&delta).map(|(a, b)| a * b).sum();
-                if decrement.abs() <= opts.decrement_tolerance * (energy.abs() + run.ks * run.r) {
-                    return Ok(run.finish(state, Status::Converged, &ev, gnorm));
-                }
-                if let Some(dmax_now) = run.exact_step(&mut state, delta, decrement, energy) {
-                    if opts.trace {
-                        tracing::info!(
-                            "step {}: E {energy:.15e} J, |g|inf {gnorm:.3e} N, g.d {decrement:.3e} J, exact \
-                             (mu {:.2e} kept), |d|max {:.3e} m, accepted at 1e0, symbolic analyses {}, exact \
-                             steps {}",
-                            run.steps,
-                            run.mu,
-                            dmax_now.min(run.d_max),
-                            run.kkt.analyses,
-                            run.exact
-                        );
+            // 3. KKT step; with the inertia rule the exact step first, kept when the energy follows its model
+            if inertia {
+                if let Some(delta) = run.exact_direction(&ev, &g)? {
+                    let decrement = dot(&g, &delta);
+                    if run.decrement_converged(decrement, energy) {
+                        return Ok(run.finish(state, Status::Converged, &ev, gnorm));
                     }
-                    run.steps += 1;
-                    run.mu = (run.mu / 10.0).max(run.mu_floor);
-                    run.backoff = 0;
-                    continue;
+                    if let Some(dmax_now) = run.exact_step(&mut state, delta, decrement, energy) {
+                        run.trace_exact(energy, gnorm, decrement, dmax_now);
+                        run.steps += 1;
+                        run.mu = (run.mu / 10.0).max(run.mu_floor);
+                        continue;
+                    }
                 }
             }
-            if opts.exact_backoff && attempted {
-                // refused: skip the next 1, 2, 4, … steps' attempts
-                run.backoff = (2 * run.backoff).clamp(1, EXACT_BACKOFF_MAX);
-                run.skip_exact = run.backoff;
-            } else if run.skip_exact > 0 {
-                run.skip_exact -= 1;
-            }
-            let direction = match (inertia, opts.psd_stencils) {
-                (true, _) if attempt => run.shifted_direction(&g)?,
-                (true, _) => run.direction(&ev, &g)?,
-                (false, PsdStencils::Fallback) => run.fallback_direction(&ev, &g, &state)?,
-                (false, PsdStencils::Off | PsdStencils::Always) => run.direction(&ev, &g)?,
+            let direction = if inertia {
+                run.shifted_direction(&g)?
+            } else {
+                run.direction(&ev, &g)?
             };
             let Some(mut delta) = direction else {
                 return Ok(run.finish(state, Status::Stalled, &ev, gnorm));
             };
-            let decrement: f64 = g.iter().zip(&delta).map(|(a, b)| a * b).sum();
-            if decrement.abs() <= opts.decrement_tolerance * (energy.abs() + run.ks * run.r) {
+            let decrement = dot(&g, &delta);
+            if run.decrement_converged(decrement, energy) {
                 return Ok(run.finish(state, Status::Converged, &ev, gnorm));
             }
-            let (accepted, dmax_now) = if opts.trust_region {
-                // 4–5. the trust-region step from the factorisation just made
-                let (accepted, length) = run.trust_region_step(&mut state, &g, energy)?;
-                if opts.trace {
-                    tracing::info!(
-                        "trust region {}: radius {:.3e} m, step {length:.3e} m, ratio {:.3e}, CG iterations {}, \
-                         boundary {}, negative curvature {}, trials {}",
-                        run.steps,
-                        run.radius,
-                        run.tr_ratio,
-                        run.tr_iterations,
-                        run.tr_boundary,
-                        run.tr_negative,
-                        run.tr_trials
-                    );
-                }
-                (accepted, length)
-            } else {
-                // 4. back to tile dofs, displacement limit
-                let dmax_now = run.limit_step(&mut delta);
-                // 5. line search, with the slope along the limited step
-                let slope = decrement * (run.d_max / dmax_now).min(1.0);
-                (run.line_search(&mut state, &delta, energy, slope), dmax_now)
-            };
-            if opts.trace {
-                tracing::info!(
-                    "step {}: E {energy:.15e} J, |g|inf {gnorm:.3e} N, g.d {decrement:.3e} J, mu {:.2e}, \
-                     |d|max {:.3e} m, accepted {}, symbolic analyses {}, projected steps {}, psd fallbacks {}",
-                    run.steps,
-                    run.mu,
-                    dmax_now.min(run.d_max),
-                    match accepted {
-                        Some(step) => format!("at {step:.0e}"),
-                        None => "none".into(),
-                    },
-                    run.kkt.analyses,
-                    run.projected,
-                    run.fallbacks
-                );
-            }
+            // 4. back to tile dofs, displacement limit; 5. line search
+            let dmax_now = run.limit_step(&mut delta);
+            let accepted = run.line_search(&mut state, &delta, energy);
+            run.trace_step(energy, gnorm, decrement, dmax_now, accepted);
             run.steps += 1;
-            if accepted.is_none() {
+            let at_roundoff = decrement.abs() <= 1e-11 * (energy.abs() + run.ks * run.r);
+            let Some(step) = accepted else {
                 // no lower energy: converged only at round-off level
-                let status = if decrement.abs() <= 1e-11 * (energy.abs() + run.ks * run.r) {
+                let status = if at_roundoff {
                     Status::Converged
                 } else {
                     Status::Stalled
                 };
                 return Ok(run.finish(state, status, &ev, gnorm));
-            }
+            };
             // with the inertia rule, a step that had to backtrack although its predicted decrease is at round-off
             // level ends the solve at the next state: the energy no longer resolves the steps (else such solves
             // can creep on by decreases of a few ulps until the step limit)
-            if inertia
-                && accepted.is_some_and(|a| a < 1.0)
-                && decrement.abs() <= 1e-11 * (energy.abs() + run.ks * run.r)
-            {
-                roundoff = true;
-            }
-            if !(opts.keep_shift && run.grew) {
-                run.mu = (run.mu / 10.0).max(run.mu_floor);
-            }
+            roundoff = inertia && step < 1.0 && at_roundoff;
+            run.mu = (run.mu / 10.0).max(run.mu_floor);
         }
     }
+}
+
+/// gᵀδ.
+fn dot(g: &[f64], delta: &[f64]) -> f64 {
+    g.iter().zip(delta).map(|(a, b)| a * b).sum()
 }
 
 /// The working state of one Newton solve ([`MicroProblem::newton`]): the tile with its contact candidates, the
@@ -597,30 +523,11 @@ struct NewtonRun<'p> {
     max_mu: f64,
     /// Newton steps taken.
     steps: usize,
-    /// Of these, exact steps on the constraint space where H + μI needed a shift above the floor.
-    projected: usize,
-    /// Whether μ had to grow in the current step.
-    grew: bool,
-    /// Exact steps of [`SolverOptions::inertia`] that were accepted.
+    /// Exact steps of the inertia rule ([`StepRule::Inertia`]) that were accepted.
     exact: usize,
-    /// [`SolverOptions::exact_backoff`]: steps whose exact attempt is still skipped, and the length of the last
-    /// skip (0 after an accepted exact step).
-    skip_exact: usize,
-    backoff: usize,
-    /// Steps that fell back to the projected Hessian ([`PsdStencils::Fallback`]).
-    fallbacks: usize,
     /// Crossings of the accepted steps and trials rejected for crossing ([`SolverOptions::crossings`]).
     crossings: Vec<Crossing>,
     rejected_crossings: usize,
-    /// [`SolverOptions::trust_region`]: the trust radius Δ (m, the norm of [`VertexNorm`]) and, of the last step,
-    /// the ratio of actual to predicted decrease, the conjugate-gradient iterations, whether the step ended on
-    /// the boundary or followed negative curvature, and the trials.
-    radius: f64,
-    tr_ratio: f64,
-    tr_iterations: usize,
-    tr_boundary: bool,
-    tr_negative: bool,
-    tr_trials: usize,
     n: usize,
     /// Yarn radius r, stretch stiffness k_s, broad-phase margin, displacement limit d_max, tile area p₁ p₂.
     r: f64,
@@ -642,7 +549,6 @@ impl<'p> NewtonRun<'p> {
         let r = problem.pattern.radius;
         let elim = Elimination::in_family(&problem.pattern, &state.strain, state.family);
         let mut tile = problem.tile(&elim);
-        tile.psd_stencils = opts.psd_stencils == PsdStencils::Always;
         let margin = opts.contact_margin * r;
         let mut timings = Timings::default();
 
@@ -654,7 +560,7 @@ impl<'p> NewtonRun<'p> {
         let rod_structure = rod_structure(&tile);
         timings.contact += tc.elapsed().as_secs_f64();
 
-        let d_max = opts.step_factor * r * state.strain.min_stretch_eigenvalue();
+        let d_max = r * state.strain.min_stretch_eigenvalue();
         Ok(NewtonRun {
             problem,
             tile,
@@ -670,20 +576,9 @@ impl<'p> NewtonRun<'p> {
             mu_floor: 0.0,
             max_mu: 0.0,
             steps: 0,
-            projected: 0,
-            grew: false,
             exact: 0,
-            skip_exact: 0,
-            backoff: 0,
-            fallbacks: 0,
             crossings: Vec::new(),
             rejected_crossings: 0,
-            radius: d_max,
-            tr_ratio: 0.0,
-            tr_iterations: 0,
-            tr_boundary: false,
-            tr_negative: false,
-            tr_trials: 0,
             n: problem.pattern.len(),
             r,
             ks: problem.material.stretch_stiffness(),
@@ -729,6 +624,71 @@ impl<'p> NewtonRun<'p> {
             }
         }
         None
+    }
+
+    /// Step 1: the energy, gradient and Hessian at `state` (exact Hessian, the stored frames) and the energy; an
+    /// error when Ψ̄ is not finite.
+    fn evaluate(&mut self, state: &MicroState) -> Result<(TileEval, f64), MicroError> {
+        let ta = Instant::now();
+        let ev = self
+            .tile
+            .evaluate(&state.frames, &state.y, Want::Hessian, &Terms::ALL)?;
+        self.timings.assembly += ta.elapsed().as_secs_f64();
+        let energy = ev.value();
+        if !(energy / self.area).is_finite() {
+            return Err(MicroError::NonFiniteEnergy {
+                strain: state.strain,
+                steps: self.steps,
+                energy,
+            });
+        }
+        Ok((ev, energy))
+    }
+
+    /// The Newton-decrement test on gᵀδ = `decrement` at the energy `energy`.
+    fn decrement_converged(&self, decrement: f64, energy: f64) -> bool {
+        let tol = self.problem.options.decrement_tolerance;
+        decrement.abs() <= tol * (energy.abs() + self.ks * self.r)
+    }
+
+    /// [`SolverOptions::trace`]: the line of an accepted exact step.
+    fn trace_exact(&self, energy: f64, gnorm: f64, decrement: f64, dmax_now: f64) {
+        if self.problem.options.trace {
+            tracing::info!(
+                "step {}: E {energy:.15e} J, |g|inf {gnorm:.3e} N, g.d {decrement:.3e} J, exact (mu {:.2e} \
+                 kept), |d|max {:.3e} m, accepted at 1e0, symbolic analyses {}, exact steps {}",
+                self.steps,
+                self.mu,
+                dmax_now.min(self.d_max),
+                self.kkt.analyses,
+                self.exact
+            );
+        }
+    }
+
+    /// [`SolverOptions::trace`]: the line of a shifted step and its line search.
+    fn trace_step(
+        &self,
+        energy: f64,
+        gnorm: f64,
+        decrement: f64,
+        dmax_now: f64,
+        accepted: Option<f64>,
+    ) {
+        if self.problem.options.trace {
+            tracing::info!(
+                "step {}: E {energy:.15e} J, |g|inf {gnorm:.3e} N, g.d {decrement:.3e} J, mu {:.2e}, |d|max \
+                 {:.3e} m, accepted {}, symbolic analyses {}",
+                self.steps,
+                self.mu,
+                dmax_now.min(self.d_max),
+                match accepted {
+                    Some(step) => format!("at {step:.0e}"),
+                    None => "none".into(),
+                },
+                self.kkt.analyses,
+            );
+        }
     }
 
     /// Back to tile dofs (θ = y_θ / r), then the displacement limit: scale the step so that no vertex moves by

@@ -5,9 +5,8 @@
 //!   only on its chain and not on scheduling, shards or interruptions.
 //! - Warm start: each step starts from the equilibrium of the step it continues (the nearest converged one up the
 //!   chain), extrapolated with the secant predictor [`MicroProblem::predict`] when that step's own predecessor
-//!   converged too, or with the tangent predictor [`MicroProblem::predict_tangent`] from the step it continues
-//!   ([`RunOptions::predictor`]); `cold` starts every sample from the reference state. A record's `time` includes
-//!   the predictor's.
+//!   converged too ([`RunOptions::predictor`]); `cold` starts every sample from the reference state. A record's
+//!   `time` includes the predictor's.
 //! - Multi-start ([`RunOptions::starts`], [`super::starts`]; issue 19, item 1): `warm+cold` also solves every
 //!   sample from the reference state and writes the lowest converged Ψ̄, listing every start.
 //! - The sample file is JSON lines, append-only: one [`Record`] per sample, written as one `write` call of the
@@ -60,8 +59,8 @@ pub struct Record {
     pub gradient_norm: Option<f64>,
     /// Wall time of the solve (s), its predictor included.
     pub time: f64,
-    /// How the solve started: `cold`, `warm` (previous equilibrium), `predicted` (secant predictor) or
-    /// `tangent` (tangent predictor).
+    /// How the solve started: `cold`, `warm` (previous equilibrium) or `predicted` (secant predictor); `tangent`
+    /// in files made with the retired tangent predictor.
     pub start: SampleStart,
     /// Hash of (pattern, yarn parameters, solver settings), 16 hex digits ([`problem_hash`]).
     pub problem: String,
@@ -133,7 +132,8 @@ pub enum SampleStart {
     Warm,
     /// From the secant predictor along its chain.
     Predicted,
-    /// From the tangent predictor y* + (dy*/dz)·Δz of the step it continues.
+    /// From the tangent predictor y* + (dy*/dz)·Δz of the step it continues: read in sample files made before the
+    /// predictor was retired (`docs/notes/retired-micro-solver-rules.md`), no longer written.
     Tangent,
     /// From the kept equilibrium of a step that continues it (the reversed chain; `--starts all`).
     Reverse,
@@ -175,13 +175,14 @@ pub struct RunSummary {
 }
 
 /// Hash of (pattern, yarn parameters, solver settings): FNV-1a 64 of the `.pyp` text, the yarn material and the
-/// solver options as JSON, as 16 hex digits.
+/// solver options in their frozen version-1 JSON form ([`crate::micro::SolverOptions::hash_text`], so that the hash
+/// of sample files made before the settings' `version` key stays), as 16 hex digits.
 pub fn problem_hash(problem: &MicroProblem) -> String {
     let text = format!(
         "{}\n{}\n{}",
         problem.pattern.to_pyp_string(),
         problem.material.hash_text(),
-        serde_json::to_string(&problem.options).unwrap_or_default()
+        problem.options.hash_text()
     );
     format!("{:016x}", fnv1a64(text.as_bytes()))
 }
@@ -466,9 +467,6 @@ impl PlanRun<'_> {
                 (Some(sb), Some(sa)) => problem.predict(sb, sa, &strain).ok().flatten(),
                 _ => None,
             },
-            Predictor::Tangent => {
-                previous.and_then(|s| problem.predict_tangent(s, &strain).ok().flatten())
-            }
             Predictor::None => None,
         };
         // the candidates: the predicted start, then the previous equilibrium itself; with the crossing guard each
@@ -476,13 +474,7 @@ impl PlanRun<'_> {
         // the first that crosses no yarns (else the cold start), `count` the first, its crossings counted
         let mut candidates: Vec<(&MicroState, SampleStart)> = Vec::new();
         if let Some(p) = predicted.as_ref() {
-            candidates.push((
-                p,
-                match self.opts.predictor {
-                    Predictor::Tangent => SampleStart::Tangent,
-                    _ => SampleStart::Predicted,
-                },
-            ));
+            candidates.push((p, SampleStart::Predicted));
         }
         candidates.extend(previous.map(|s| (s, SampleStart::Warm)));
         let mut start = None;

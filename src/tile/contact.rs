@@ -67,8 +67,7 @@ pub(super) fn assemble(
                     h: Default::default(),
                 }))
             } else {
-                let mut r = kernel.value_gradient_hessian(&x, la, lb)?;
-                tile.project_local(want, &mut r.hessian);
+                let r = kernel.value_gradient_hessian(&x, la, lb)?;
                 Ok(Some(super::Local {
                     value: r.value,
                     g: r.gradient,

@@ -8,7 +8,6 @@
 //! value, gradient and Hessian are those of one smooth function of the dofs (what the derivative harness checks).
 
 pub mod contact;
-pub mod psd;
 
 pub use contact::ContactPair;
 
@@ -134,9 +133,6 @@ pub struct Tile<'a> {
     pub contacts: Vec<ContactPair>,
     /// Radius of the contact distance 2r: the yarn radius times the material's contact radius factor.
     pub contact_radius: f64,
-    /// Project every stencil's and contact pair's local Hessian to positive semi-definite before it is scattered
-    /// ([`psd::project_psd`]; the micro solver's `psd_stencils` option). Off by default: the exact Hessian.
-    pub psd_stencils: bool,
 }
 
 /// One local stencil result: dofs as (vertex, offset) for positions and edge indices for angles.
@@ -161,7 +157,6 @@ impl<'a> Tile<'a> {
             dof_map: None,
             contacts: Vec::new(),
             contact_radius,
-            psd_stencils: false,
         }
     }
 
@@ -255,8 +250,7 @@ impl<'a> Tile<'a> {
                     let e = &self.pattern.edges[i];
                     let a = self.position(y, i, [0, 0]);
                     let b = self.position(y, e.end, e.offset);
-                    let (value, g, mut h) = stretch_vgh(&a, &b, e.rest_length, ks);
-                    self.project_local(want, &mut h);
+                    let (value, g, h) = stretch_vgh(&a, &b, e.rest_length, ks);
                     Local { value, g, h }
                 })
                 .collect();
@@ -278,8 +272,7 @@ impl<'a> Tile<'a> {
                     let th = [y[3 * n + s.edges[0]], y[3 * n + s.edges[1]]];
                     let (_, _, fr) = frames.stencil(s, &self.placement);
                     let p = self.bend_params(i, terms);
-                    let ([eb, et], g, mut h) = bend_twist_parts_vgh(&x, th, &fr, &p);
-                    self.project_local(want, &mut h);
+                    let ([eb, et], g, h) = bend_twist_parts_vgh(&x, th, &fr, &p);
                     (
                         eb,
                         et,
@@ -456,19 +449,6 @@ impl<'a> Tile<'a> {
             }
         }
         Ok(acc.into_iter().map(|(o, (f, m))| (o, f, m)).collect())
-    }
-
-    /// A local Hessian as it is scattered: projected to positive semi-definite when [`Tile::psd_stencils`] is set
-    /// and the evaluation wants the Hessian, else unchanged.
-    #[inline]
-    pub(crate) fn project_local<const N: usize>(
-        &self,
-        want: Want,
-        h: &mut nalgebra::SMatrix<f64, N, N>,
-    ) {
-        if self.psd_stencils && want == Want::Hessian {
-            psd::project_psd(h);
-        }
     }
 
     /// Add a stencil's local gradient and Hessian: `pos` lists (vertex, offset) for consecutive 3-blocks of the

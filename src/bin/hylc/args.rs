@@ -2,7 +2,7 @@
 
 use clap::ValueEnum;
 use hylc::micro::reference::Construction;
-use hylc::micro::{CrossingGuard, PsdStencils, SolverOptions};
+use hylc::micro::{CrossingGuard, SolverOptions, StepRule};
 use hylc::rod::YarnMaterial;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -19,60 +19,18 @@ pub struct SolverArgs {
     /// wall-time limit per solve in seconds
     #[arg(long)]
     pub time_limit: Option<f64>,
-    /// where H + μI needs a shift above its floor, take the exact Newton step on the constraint space
-    /// (projected conjugate gradients) when H is positive definite there, instead of the shifted step
-    #[arg(long)]
-    pub projected_steps: bool,
-    /// after a step whose factorisation needed a larger shift μ, start the next step at that μ (not μ/10)
-    #[arg(long)]
-    pub keep_shift: bool,
-    /// project each rod stencil's and contact pair's local Hessian to positive semi-definite: always, or only
-    /// where the exact H + μI does not factorise at μ's floor (fallback); off: the exact Hessian with the μ shift
-    #[arg(long, value_enum, default_value = "off")]
-    pub psd_stencils: PsdStencilsArg,
     /// yarn crossings along the Newton path and, in a sample chain, on the way to each warm or predicted start:
     /// not checked (off), counted (count), or line-search trials and starts that pass two yarn centre lines
-    /// through each other rejected (reject); default off (`sample --starts warm+cold|all`: reject)
+    /// through each other rejected (reject); default off (`sample --starts warm+cold|all`: reject). A measured
+    /// trade (README, "The crossing guard"): reject keeps every sample in its fabric, at 0.34–1.2× the speed
     #[arg(long, value_enum)]
     pub crossings: Option<CrossingGuard>,
-    /// trust-region Newton steps (truncated conjugate gradients preconditioned by the shifted factorisation,
-    /// following negative curvature to the boundary) instead of the displacement limit and the backtracking
-    #[arg(long)]
-    pub trust_region: bool,
     /// the design's shift rule alone (μ grown until H + μI is positive definite) instead of the default
     /// inertia-controlled steps (the exact constrained Newton step wherever H is positive definite on the
-    /// constraint space and the energy follows its quadratic model)
+    /// constraint space and the energy follows its quadratic model); reproduces the solver before 5 December
+    /// 2026 bit for bit, and sample files made before then resume only with it
     #[arg(long)]
     pub no_inertia: bool,
-    /// with the inertia-controlled steps: after a refused exact step, skip the exact attempt for the next 1, 2,
-    /// 4, …, 16 steps (doubled after each consecutive refusal)
-    #[arg(long, conflicts_with = "no_inertia")]
-    pub exact_backoff: bool,
-    /// line search: after a refused trial step, the next from the parabola through E(0), the slope at 0 and the
-    /// refused trial's energy (within 0.1–0.5 of the refused step) instead of the fixed factor 0.1
-    #[arg(long)]
-    pub interpolating_search: bool,
-    /// displacement limit factor: no vertex moves more than F · r · λ_min(Ī) per Newton step (the design's 1)
-    #[arg(long, default_value_t = 1.0, value_name = "F", value_parser = positive_finite, allow_hyphen_values = true)]
-    pub step_factor: f64,
-}
-
-/// `--psd-stencils` ([`PsdStencils`]).
-#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PsdStencilsArg {
-    Off,
-    Always,
-    Fallback,
-}
-
-impl From<PsdStencilsArg> for PsdStencils {
-    fn from(p: PsdStencilsArg) -> Self {
-        match p {
-            PsdStencilsArg::Off => PsdStencils::Off,
-            PsdStencilsArg::Always => PsdStencils::Always,
-            PsdStencilsArg::Fallback => PsdStencils::Fallback,
-        }
-    }
 }
 
 impl SolverArgs {
@@ -82,15 +40,12 @@ impl SolverArgs {
             tolerance: self.tolerance,
             max_steps: self.max_steps,
             time_limit: self.time_limit,
-            projected_steps: self.projected_steps,
-            keep_shift: self.keep_shift,
-            psd_stencils: self.psd_stencils.into(),
             crossings: self.crossings.unwrap_or_default(),
-            trust_region: self.trust_region,
-            inertia: !self.no_inertia,
-            exact_backoff: self.exact_backoff,
-            interpolating_search: self.interpolating_search,
-            step_factor: self.step_factor,
+            step_rule: if self.no_inertia {
+                StepRule::Shift
+            } else {
+                StepRule::Inertia
+            },
             ..Default::default()
         }
     }
@@ -162,15 +117,6 @@ pub fn exit(ok: bool, code: u8) -> ExitCode {
         ExitCode::SUCCESS
     } else {
         ExitCode::from(code)
-    }
-}
-
-/// A clap value parser: a finite number > 0.
-fn positive_finite(text: &str) -> Result<f64, String> {
-    match text.parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        Ok(v) => Err(format!("expected a finite number > 0, got {v}")),
-        Err(e) => Err(format!("{e}")),
     }
 }
 

@@ -33,7 +33,7 @@ pub struct Args {
     solver: SolverArgs,
     #[command(flatten)]
     yarn: YarnArgs,
-    /// no per-yarn slide constraints
+    /// no per-yarn slide constraints (an option of the original solver, kept to reproduce it)
     #[arg(long)]
     no_slide_constraints: bool,
     /// keep the `.pyp` file's periods even where they disagree with the rest lengths (by default the

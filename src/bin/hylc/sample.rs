@@ -34,8 +34,8 @@ pub struct Args {
     /// stop after writing this many samples
     #[arg(long)]
     limit: Option<usize>,
-    /// predictor of warm starts along a chain: secant (from the two previous equilibria), tangent
-    /// (y* + dy*/dz Δz from the previous one) or none (the previous equilibrium itself)
+    /// predictor of warm starts along a chain: secant (from the two previous equilibria) or none (the previous
+    /// equilibrium itself)
     #[arg(long, value_enum, default_value_t = Predictor::Secant)]
     predictor: Predictor,
     /// starts of every sample (issue 19, item 1): warm (along the chain), or warm+cold (also from the reference

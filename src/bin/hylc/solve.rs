@@ -27,18 +27,14 @@ pub struct Args {
     /// warm start from the previous solution only (no extrapolation along the chain; `--predictor none`)
     #[arg(long)]
     no_predictor: bool,
-    /// predictor of warm starts along the chain: secant (from the two previous solutions), tangent
-    /// (y* + dy*/dz Δz from the previous one) or none
+    /// predictor of warm starts along the chain: secant (from the two previous solutions) or none
     #[arg(long, value_enum, default_value_t = Predictor::Secant)]
     predictor: Predictor,
     #[command(flatten)]
     solver: SolverArgs,
     #[command(flatten)]
     yarn: YarnArgs,
-    /// line-search backtracking factor (trial steps factor^i down to 1e-10)
-    #[arg(long, default_value_t = 0.1)]
-    backtracking: f64,
-    /// no per-yarn slide constraints
+    /// no per-yarn slide constraints (an option of the original solver, kept to reproduce it)
     #[arg(long)]
     no_slide_constraints: bool,
     /// write the yarn centre lines as OBJ polylines (one file per strain when several)
@@ -68,7 +64,6 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     }
     let options = SolverOptions {
         trace: a.trace,
-        backtracking: a.backtracking,
         slide_constraints: !a.no_slide_constraints,
         ..a.solver.options()
     };
@@ -105,9 +100,6 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
                 if !cold && a.psi().is_ok() && b.psi().is_ok() =>
             {
                 problem.predict(&a.state, &b.state, strain)?
-            }
-            (_, Some(b), Predictor::Tangent) if !cold && b.psi().is_ok() => {
-                problem.predict_tangent(&b.state, strain)?
             }
             _ => None,
         };

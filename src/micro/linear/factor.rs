@@ -36,21 +36,6 @@ pub(super) enum Factor<'a> {
 }
 
 impl<'a> Factor<'a> {
-    /// The factor kept in `values` by a factorisation of `kind` (its negative pivots counted again).
-    pub(super) fn kept(
-        kind: Factorization,
-        symbolic: &'a SymbolicCholesky<usize>,
-        values: &'a [f64],
-    ) -> Self {
-        match kind {
-            Factorization::Cholesky => Factor::Llt(LltRef::new(symbolic, values)),
-            Factorization::Inertia => {
-                let (negative, _) = pivot_signs(symbolic, values);
-                Factor::Ldlt(LdltRef::new(symbolic, values), negative)
-            }
-        }
-    }
-
     /// K⁻¹ applied in place to the columns of `rhs`.
     pub(super) fn solve_in_place(&self, rhs: MatMut<'_, f64>, stack: &mut MemStack) {
         match self {

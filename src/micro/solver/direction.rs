@@ -1,14 +1,8 @@
 //! The Newton direction of one micro-solver iteration (`03-homogenization.md`, sections 3–4, step 3): the KKT
-//! step with the regularisation μ grown ×10 until it exists (the design's rule), the exact constrained step of
-//! [`SolverOptions::inertia`] tried first, and the per-stencil projection fallback ([`PsdStencils::Fallback`]).
+//! step with the regularisation μ grown ×10 until it exists (the design's rule), and the exact constrained step of
+//! [`StepRule::Inertia`] tried first.
 
 use super::*;
-
-/// Relative tolerance (√(rᵀz) against its start) of the projected conjugate gradients of
-/// [`SolverOptions::projected_steps`].
-const PROJECTED_TOLERANCE: f64 = 1e-10;
-/// Iteration limit of those conjugate gradients (beyond it the shifted step is taken).
-const PROJECTED_MAX_ITERATIONS: usize = 100;
 
 impl<'p> NewtonRun<'p> {
     /// The KKT step in the scaled unknowns, growing μ until H + μI factorises and the step is a descent
@@ -20,12 +14,11 @@ impl<'p> NewtonRun<'p> {
     ) -> Result<Option<Vec<f64>>, MicroError> {
         let tf = Instant::now();
         self.set_newton_matrix(ev)?;
-        self.grew = false;
         self.timings.factorization += tf.elapsed().as_secs_f64();
         self.shifted_direction(g)
     }
 
-    /// [`SolverOptions::inertia`]: store the Hessian of `ev`; where the design's rule would start above μ's floor,
+    /// [`StepRule::Inertia`]: store the Hessian of `ev`; where the design's rule would start above μ's floor,
     /// the exact constrained Newton step at the floor when the KKT matrix there has the inertia of a constrained
     /// minimum; `None` otherwise, and [`NewtonRun::shifted_direction`] goes on from μ (its shifts accepted by the
     /// same inertia test). μ keeps its value, the shifted search's memory.
@@ -36,7 +29,6 @@ impl<'p> NewtonRun<'p> {
     ) -> Result<Option<Vec<f64>>, MicroError> {
         let tf = Instant::now();
         self.set_newton_matrix(ev)?;
-        self.grew = false;
         let mut delta = None;
         if self.mu > self.mu_floor {
             let saved = self.mu;
@@ -59,25 +51,6 @@ impl<'p> NewtonRun<'p> {
                 break;
             }
             self.mu *= 10.0;
-            self.grew = true;
-        }
-        // A shift above the floor means H is not positive definite in the full space; it may still be on the
-        // constraint space (e.g. a slide constraint holding back a yarn that would slide), where the exact
-        // Newton step exists: projected conjugate gradients with the factorisation just made as the
-        // preconditioner. Where they meet negative curvature, the shifted step stays.
-        if delta.is_some() && self.mu > self.mu_floor && self.problem.options.projected_steps {
-            let exact = self.kkt.solve_projected_kept(
-                g,
-                &self.problem.constraints,
-                PROJECTED_TOLERANCE,
-                PROJECTED_MAX_ITERATIONS,
-            );
-            if let Ok(d) = exact {
-                if g.iter().zip(&d).map(|(a, b)| a * b).sum::<f64>() < 0.0 {
-                    delta = Some(d);
-                    self.projected += 1;
-                }
-            }
         }
         self.timings.factorization += tf.elapsed().as_secs_f64();
         self.max_mu = self.max_mu.max(self.mu);
@@ -130,37 +103,5 @@ impl<'p> NewtonRun<'p> {
             Ok(_) | Err(FactorError::NotPositiveDefinite) => Ok(None),
             Err(e) => Err(MicroError::Linear(e)),
         }
-    }
-
-    /// [`PsdStencils::Fallback`]: the exact KKT step at μ's floor when H + μ_floor I factorises and gives a descent
-    /// direction; else the step of [`NewtonRun::direction`] on the Hessian with every stencil projected to
-    /// positive semi-definite (evaluated again at `state`), which grows μ only when that one fails too.
-    pub(super) fn fallback_direction(
-        &mut self,
-        ev: &TileEval,
-        g: &[f64],
-        state: &MicroState,
-    ) -> Result<Option<Vec<f64>>, MicroError> {
-        let tf = Instant::now();
-        self.set_newton_matrix(ev)?;
-        self.grew = false;
-        let saved = self.mu;
-        self.mu = self.mu_floor;
-        let exact = self.try_step(g)?;
-        self.timings.factorization += tf.elapsed().as_secs_f64();
-        if let Some(d) = exact {
-            self.max_mu = self.max_mu.max(self.mu);
-            return Ok(Some(d));
-        }
-        self.mu = saved;
-        let ta = Instant::now();
-        self.tile.psd_stencils = true;
-        let projected = self
-            .tile
-            .evaluate(&state.frames, &state.y, Want::Hessian, &Terms::ALL);
-        self.tile.psd_stencils = false;
-        self.timings.assembly += ta.elapsed().as_secs_f64();
-        self.fallbacks += 1;
-        self.direction(&projected?, g)
     }
 }
