@@ -113,6 +113,9 @@ pub enum ShellError {
     /// A time tolerance that is not a positive finite length.
     #[error("time tolerance {tol}: expected a positive finite length (m)")]
     TimeTolerance { tol: f64 },
+    /// Zero substeps per step.
+    #[error("substeps per step: expected at least 1, got 0")]
+    Substeps,
     /// More obstacle motions than obstacles were given to a simulation.
     #[error("{motions} obstacle motions for {obstacles} obstacles (one per obstacle at most)")]
     ObstacleMotions { motions: usize, obstacles: usize },

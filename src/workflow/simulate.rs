@@ -16,6 +16,10 @@ pub struct Overrides {
     pub dt: Option<f64>,
     /// The largest estimated local error of a substep (m), `solver.time_tol`.
     pub time_tol: Option<f64>,
+    /// The scheme of a substep, `solver.integrator`.
+    pub integrator: Option<crate::shell::solver::Integrator>,
+    /// Equal substeps per step, `solver.substeps`.
+    pub substeps: Option<u32>,
     /// The edge length of a rectangle mesh.
     pub edge: Option<f64>,
     pub psd: Option<Psd>,
@@ -71,6 +75,17 @@ pub fn prepare_noted(
             )));
         }
         scene.solver.time_tol = Some(tol);
+    }
+    if let Some(i) = ov.integrator {
+        scene.solver.integrator = i;
+    }
+    if let Some(k) = ov.substeps {
+        if k == 0 {
+            return Err(WorkflowError::Input(
+                "--substeps 0: expected at least one substep per step".into(),
+            ));
+        }
+        scene.solver.substeps = k;
     }
     if let Some(e) = ov.edge {
         match &mut scene.mesh {

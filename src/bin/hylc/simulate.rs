@@ -3,6 +3,7 @@
 
 use crate::printer::Printer;
 use clap::ValueEnum;
+use hylc::shell::solver::Integrator;
 use hylc::shell::Psd;
 use hylc::workflow::simulate::{
     diverged, execute, prepare_noted, snapshot, summary_line, Overrides,
@@ -36,6 +37,14 @@ pub struct Args {
     /// solver.time_tol; by default substeps shorten only when Newton fails)
     #[arg(long, value_name = "METRES")]
     time_tol: Option<f64>,
+    /// the scheme of a substep: implicit-euler (Newton to the force tolerance) or linearized (the original
+    /// simulator's: one Newton step, no line search; with --substeps set to the original's frame_steps it takes
+    /// the original's steps)
+    #[arg(long, value_enum)]
+    integrator: Option<IntegratorArg>,
+    /// equal substeps per step (the original's frame_steps), before any adaptive halving
+    #[arg(long, value_name = "N")]
+    substeps: Option<u32>,
     /// edge length (m) of a rectangle mesh instead of the scene's
     #[arg(long)]
     edge: Option<f64>,
@@ -58,6 +67,22 @@ pub struct Args {
     /// paths relative to its folder: save it there)
     #[arg(long)]
     print: bool,
+}
+
+/// The scheme of a substep (`hylc::shell::solver::Integrator`).
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum IntegratorArg {
+    ImplicitEuler,
+    Linearized,
+}
+
+impl From<IntegratorArg> for Integrator {
+    fn from(i: IntegratorArg) -> Self {
+        match i {
+            IntegratorArg::ImplicitEuler => Integrator::ImplicitEuler,
+            IntegratorArg::Linearized => Integrator::Linearized,
+        }
+    }
 }
 
 /// The Hessian projection (`hylc::shell::Psd`).
@@ -84,6 +109,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         duration: a.duration,
         dt: a.dt,
         time_tol: a.time_tol,
+        integrator: a.integrator.map(Into::into),
+        substeps: a.substeps,
         edge: a.edge,
         psd: a.psd.map(Into::into),
         no_bending: a.no_bending,

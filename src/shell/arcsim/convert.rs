@@ -99,7 +99,8 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
             "frame_steps",
             &format!(
                 "ignored: the original's {k} substeps of {:.3e} s per frame; here one implicit step per frame \
-                 (dt = frame_time = {dt} s), halved adaptively when Newton needs it",
+                 (dt = frame_time = {dt} s), halved adaptively when Newton needs it (`--integrator linearized \
+                 --substeps {k}` takes the original's steps)",
                 dt / k
             ),
         );

@@ -76,6 +76,8 @@ impl Scene {
             handle_stiffness: self.handle_stiffness,
             max_halvings: self.solver.max_halvings,
             time_tol: self.solver.time_tol,
+            integrator: self.solver.integrator,
+            substeps: self.solver.substeps,
         };
         let obstacles = self.obstacles(file, dir)?;
         let sim = Simulation::new(

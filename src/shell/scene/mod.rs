@@ -21,7 +21,9 @@
 //!             "collapse_barrier": {"area": 0.2, "stiffness": 1.0}}, // null: none (`super::fold`)
 //!   "psd": "full",                               // "full" (18×18), "psi" (6×6), "none" (diagonal shift)
 //!   "solver": {"force_tol": 1e-6, "max_newton": 50, "exact_first": true, "max_halvings": 6,
-//!              "time_tol": null},                // a length (m): substeps chosen by their estimated error
+//!              "time_tol": null,                 // a length (m): substeps chosen by their estimated error
+//!              "integrator": "implicit-euler",   // or "linearized" (ARCSim's scheme, one Newton step)
+//!              "substeps": 1},                   // equal substeps per step (ARCSim's frame_steps)
 //!   "pins": [{"near": {"point": [0, 0], "radius": 0.01}}],
 //!   "handles": [{"name": "left", "select": {"box": {"min": [0, 0.05], "max": [0.021, 0.25]}},
 //!                "keyframes": [[0, [0, 0, 0]], [0.25, [-0.02, 0, 0]]],
@@ -49,6 +51,7 @@ pub use super::fold::{CollapseBarrier, FoldBarrier};
 use super::mesh::{load_obj_surface, write_obj, Mesh};
 pub use super::motion::{Interpolation, Keyframe, Motion};
 use super::obstacle::{MeshObstacle, Obstacle};
+pub use super::solver::Integrator;
 use super::solver::{Boundary, Handle, Settings, Simulation, StepReport};
 use super::ShellError;
 use crate::material::synthetic::default_material;
@@ -304,6 +307,20 @@ pub struct SolverSpec {
     /// Newton fails (`super::solver`, "Accuracy")
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_tol: Option<f64>,
+    /// the scheme of a substep (`super::solver`, "Integrators")
+    #[serde(skip_serializing_if = "is_implicit_euler")]
+    pub integrator: Integrator,
+    /// equal substeps per step (ARCSim's `frame_steps`), before any adaptive halving
+    #[serde(skip_serializing_if = "is_one")]
+    pub substeps: u32,
+}
+
+fn is_implicit_euler(i: &Integrator) -> bool {
+    *i == Integrator::ImplicitEuler
+}
+
+fn is_one(k: &u32) -> bool {
+    *k == 1
 }
 
 impl Default for SolverSpec {
@@ -315,6 +332,8 @@ impl Default for SolverSpec {
             exact_first: s.exact_first,
             max_halvings: s.max_halvings,
             time_tol: s.time_tol,
+            integrator: s.integrator,
+            substeps: s.substeps,
         }
     }
 }
@@ -483,6 +502,9 @@ pub const MAX_GRAVITY: f64 = 1e4;
 /// The most Newton iterations per step a scene may ask for (`solver.max_newton`): the default is 50; more than
 /// 10 000 only delays the report of a step that does not converge.
 pub const MAX_NEWTON: usize = 10_000;
+
+/// The most equal substeps per step a scene may ask for (`solver.substeps`; the original's scenes use 50–100).
+pub const MAX_SUBSTEPS: u32 = 100_000;
 
 /// The most time-step halvings a scene may allow (`solver.max_halvings`): 2⁻²⁰ of a step is below any
 /// useful time scale of cloth.

@@ -161,6 +161,15 @@ impl Scene {
                 ),
             );
         }
+        if !(1..=MAX_SUBSTEPS).contains(&self.solver.substeps) {
+            return bad(
+                "solver.substeps",
+                format!(
+                    "must be a whole number from 1 to {MAX_SUBSTEPS}, got {}",
+                    self.solver.substeps
+                ),
+            );
+        }
         if let Some(tol) = self.solver.time_tol {
             if !(tol > 0.0 && tol.is_finite()) {
                 return bad(

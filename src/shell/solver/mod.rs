@@ -77,6 +77,17 @@ pub struct Boundary {
     pub obstacle_motions: Vec<Motion>,
 }
 
+/// How a substep advances (module documentation, "Integrators").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Integrator {
+    /// implicit Euler: Φ minimised by Newton's method to the force tolerance
+    #[default]
+    ImplicitEuler,
+    /// ARCSim's linearised implicit Euler: one Newton step from xₙ with the PSD Hessian, no line search
+    Linearized,
+}
+
 /// Solver settings.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Settings {
@@ -112,6 +123,10 @@ pub struct Settings {
     /// `Some(τ)`: substep lengths chosen so that the estimated local error of each substep is at most τ (m)
     /// (module documentation, "Accuracy"); `None`: substeps only shorten when Newton fails
     pub time_tol: Option<f64>,
+    /// the scheme of a substep
+    pub integrator: Integrator,
+    /// every step is divided into this many equal substeps (≥ 1) before any adaptive halving
+    pub substeps: u32,
 }
 
 impl Default for Settings {
@@ -133,6 +148,8 @@ impl Default for Settings {
             handle_stiffness: None,
             max_halvings: 6,
             time_tol: None,
+            integrator: Integrator::ImplicitEuler,
+            substeps: 1,
         }
     }
 }
@@ -349,7 +366,10 @@ impl Simulation {
                 return Err(ShellError::TimeTolerance { tol });
             }
         }
-        let settings_dt = settings.dt;
+        if settings.substeps == 0 {
+            return Err(ShellError::Substeps);
+        }
+        let settings_dt = settings.dt / f64::from(settings.substeps);
         let mut constrained = vec![false; n];
         for &v in pinned
             .iter()
@@ -483,15 +503,16 @@ impl Simulation {
     /// documentation).
     pub fn step(&mut self) -> Result<StepReport, ShellError> {
         let start = Instant::now();
-        let dt = self.settings.dt;
-        let t_end = self.time + dt;
+        let t_end = self.time + self.settings.dt;
+        // the longest substep: the step divided into `substeps`
+        let dt = self.settings.dt / f64::from(self.settings.substeps);
         let step = self.steps + 1;
         let h_min = dt / f64::from(1u32 << self.settings.max_halvings);
         let tol = self
             .settings
             .time_tol
             .filter(|_| !self.settings.quasi_static);
-        let (mut newton, mut substeps, mut rejected, mut dt_min) = (0, 0, 0, dt);
+        let (mut newton, mut substeps, mut rejected, mut dt_min) = (0, 0, 0, self.settings.dt);
         let (mut max_shift, mut error_max): (f64, f64) = (0.0, 0.0);
         let mut last: Option<(Minimum, Target)> = None;
         // the step ends when the remaining time is a round-off fraction of dt
@@ -657,7 +678,11 @@ impl Simulation {
                 )
             }
         };
-        let m = match self.minimise(x, &tg, phi) {
+        let m = match self.settings.integrator {
+            Integrator::ImplicitEuler => self.minimise(x, &tg, phi),
+            Integrator::Linearized => self.linearized(x, &tg),
+        };
+        let m = match m {
             Ok(m) => m,
             Err(e) => return retry(e),
         };
@@ -737,7 +762,7 @@ impl Simulation {
             springs,
             lagged,
         };
-        if !s.quasi_static {
+        if !s.quasi_static && s.integrator == Integrator::ImplicitEuler {
             let mut guess = x.clone();
             for v in 0..n {
                 if self.pattern.free[v].is_some() {
@@ -751,6 +776,37 @@ impl Simulation {
             }
         }
         Ok((tg, x))
+    }
+
+    /// ARCSim's linearised implicit Euler (module documentation, "Integrators"): one Newton step on Φ from `x`
+    /// (xₙ, held vertices at their targets) with the PSD option's Hessian and no line search; the result counts
+    /// as converged, with the residual force it leaves.
+    fn linearized(&self, mut x: Vec<f64>, tg: &Target) -> Result<Minimum, ShellError> {
+        let (asm, g_full) = self.gradient_hessian(&x, tg)?;
+        let (gf, _) = self.free_gradient(&g_full);
+        let (d, max_shift) = if gf.is_empty() {
+            (vec![], 0.0)
+        } else {
+            self.solve(&asm.values, &[], &gf)?
+        };
+        for v in 0..self.pattern.n {
+            if let Some(k) = self.pattern.free[v] {
+                for c in 0..3 {
+                    x[3 * v + c] += d[3 * k + c];
+                }
+            }
+        }
+        let (asm, g_full) = self.gradient_hessian(&x, tg)?;
+        let (_, residual) = self.free_gradient(&g_full);
+        Ok(Minimum {
+            x,
+            newton: usize::from(!gf.is_empty()),
+            residual,
+            converged: true,
+            max_shift,
+            asm,
+            g_full,
+        })
     }
 
     /// Newton's method on Φ from `x` (where Φ = `phi`): converged when the largest residual force on a free
