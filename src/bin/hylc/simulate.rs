@@ -37,9 +37,9 @@ pub struct Args {
     /// solver.time_tol; by default substeps shorten only when Newton fails)
     #[arg(long, value_name = "METRES")]
     time_tol: Option<f64>,
-    /// the scheme of a substep: implicit-euler (Newton to the force tolerance) or linearized (the original
-    /// simulator's: one Newton step, no line search; with --substeps set to the original's frame_steps it takes
-    /// the original's steps)
+    /// the scheme of a substep: implicit-euler (Newton to the force tolerance), bdf2 (second order, the same
+    /// Newton solve) or linearized (the original simulator's: one Newton step, no line search; with --substeps
+    /// set to the original's frame_steps it takes the original's steps)
     #[arg(long, value_enum)]
     integrator: Option<IntegratorArg>,
     /// equal substeps per step (the original's frame_steps), before any adaptive halving
@@ -73,6 +73,7 @@ pub struct Args {
 #[derive(ValueEnum, Clone, Copy, Debug)]
 enum IntegratorArg {
     ImplicitEuler,
+    Bdf2,
     Linearized,
 }
 
@@ -80,6 +81,7 @@ impl From<IntegratorArg> for Integrator {
     fn from(i: IntegratorArg) -> Self {
         match i {
             IntegratorArg::ImplicitEuler => Integrator::ImplicitEuler,
+            IntegratorArg::Bdf2 => Integrator::Bdf2,
             IntegratorArg::Linearized => Integrator::Linearized,
         }
     }

@@ -35,8 +35,12 @@
 //! of p − oᵢ found in the shape's own placement, then translated), and lagged friction charges the tangential
 //! displacement relative to the obstacle, δ = x − xₙ − (oᵢ(t₁) − oᵢ(tₙ)).
 
+mod integrator;
 mod linear;
 mod terms;
+
+pub use integrator::{bdf2_coefficients, Integrator};
+use integrator::{Anchor, History};
 
 use super::assemble::{energy, gather, Assembled, Pattern};
 use super::dissipation::{self, Wind};
@@ -75,17 +79,6 @@ pub struct Boundary {
     pub obstacles: Vec<Obstacle>,
     /// the translation of each obstacle over time, in the order of `obstacles` (missing ones stay put)
     pub obstacle_motions: Vec<Motion>,
-}
-
-/// How a substep advances (module documentation, "Integrators").
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Integrator {
-    /// implicit Euler: Φ minimised by Newton's method to the force tolerance
-    #[default]
-    ImplicitEuler,
-    /// ARCSim's linearised implicit Euler: one Newton step from xₙ with the PSD Hessian, no line search
-    Linearized,
 }
 
 /// Solver settings.
@@ -286,6 +279,8 @@ pub struct Simulation {
     streak: u32,
     /// the next substep length under `time_tol` (s)
     h_next: f64,
+    /// the start of the previous accepted substep (BDF2 only)
+    history: Option<History>,
     /// the local PSD Hessians at the state `.0` (the last converged assembly), which the next substep's damping
     /// reuses instead of assembling them again
     damping_cache: Option<DampingCache>,
@@ -294,14 +289,22 @@ pub struct Simulation {
 /// The state and the local PSD Hessians assembled there.
 type DampingCache = (Vec<f64>, std::sync::Arc<Vec<[[f64; NDOF]; NDOF]>>);
 
-/// Per-substep constants of the potential.
+/// Per-substep constants of the potential ([`integrator`]'s scheme constants).
 struct Target {
-    /// substep length h
+    /// the effective step ĥ of the inertia and dissipation terms (the substep length for implicit Euler)
     h: f64,
+    /// the substep length (s)
+    step: f64,
     /// the time at the end of the substep, t₁ = tₙ + h
     time: f64,
+    /// the inertial target x̂
     xt: Vec<f64>,
+    /// the velocity anchor x_b: v = (x − x_b)/ĥ (xₙ for implicit Euler)
     xn: Vec<f64>,
+    /// BDF2's predictor (its error estimate)
+    xp: Option<Vec<f64>>,
+    /// the order of the substep's scheme (its error is O(h^(order + 1)))
+    order: i32,
     /// spring targets of the held vertices (vertex, position) when handles are springs
     springs: Vec<(usize, [f64; 3])>,
     /// geometry and forces frozen at xₙ (damping Hessians, drag faces, friction contacts)
@@ -429,6 +432,7 @@ impl Simulation {
             level: 0,
             streak: 0,
             h_next: settings_dt,
+            history: None,
             damping_cache: None,
         })
     }
@@ -534,7 +538,7 @@ impl Simulation {
                     let (mut m, tg) = *done;
                     let err = self.substep_error(&m.x, &tg);
                     if let Some(tol) = tol {
-                        let factor = 0.9 * (tol / err).sqrt();
+                        let factor = 0.9 * (tol / err).powf(1.0 / f64::from(tg.order + 1));
                         if err > tol && h > h_min * (1.0 + 1e-9) {
                             // too inaccurate: retry shorter (the Newton work counts)
                             newton += m.newton;
@@ -632,21 +636,15 @@ impl Simulation {
         })
     }
 
-    /// The estimated local error of a substep that ended at `x`: maxᵥ ½ |xᵥ − x̃ᵥ| over the free vertices (m;
-    /// module documentation, "Accuracy"), 0 in quasi-static mode.
+    /// The estimated local error of a substep that ended at `x` over the free vertices (m; module
+    /// documentation, "Accuracy", and [`integrator`]), 0 in quasi-static mode.
     fn substep_error(&self, x: &[f64], tg: &Target) -> f64 {
         if self.settings.quasi_static {
             return 0.0;
         }
-        (0..self.pattern.n)
-            .filter(|&v| self.pattern.free[v].is_some())
-            .map(|v| {
-                let d2: f64 = (0..3)
-                    .map(|c| (x[3 * v + c] - tg.xt[3 * v + c]).powi(2))
-                    .sum();
-                0.5 * d2.sqrt()
-            })
-            .fold(0.0, f64::max)
+        integrator::local_error(x, &tg.xt, tg.xp.as_deref(), |v| {
+            self.pattern.free[v].is_some()
+        })
     }
 
     /// One substep of length h from the current state (not yet accepted). Errors a smaller h may cure
@@ -679,7 +677,7 @@ impl Simulation {
             }
         };
         let m = match self.settings.integrator {
-            Integrator::ImplicitEuler => self.minimise(x, &tg, phi),
+            Integrator::ImplicitEuler | Integrator::Bdf2 => self.minimise(x, &tg, phi),
             Integrator::Linearized => self.linearized(x, &tg),
         };
         let m = match m {
@@ -706,6 +704,12 @@ impl Simulation {
 
     /// Take a substep's minimiser as the new state.
     fn accept(&mut self, m: &Minimum, tg: &Target) {
+        let start = (self.settings.integrator == Integrator::Bdf2).then(|| History {
+            x: self.x.clone(),
+            v: self.v.clone(),
+            h: tg.step,
+            t: self.time,
+        });
         for i in 0..m.x.len() {
             self.v[i] = if self.settings.quasi_static {
                 0.0
@@ -714,7 +718,8 @@ impl Simulation {
             };
         }
         self.x.clone_from(&m.x);
-        self.time += tg.h;
+        self.time += tg.step;
+        self.history = start;
     }
 
     /// The prescribed position of every held vertex at time t (pins at x0, handles at x0 + offset).
@@ -737,12 +742,26 @@ impl Simulation {
         let s = &self.settings;
         let n = self.pattern.n;
         let xn = self.x.clone();
-        let mut xt = xn.clone();
-        if !s.quasi_static {
-            for i in 0..xt.len() {
-                xt[i] += h * self.v[i];
-            }
-        }
+        let anchor = Anchor::new(
+            s.integrator,
+            s.quasi_static,
+            &xn,
+            &self.v,
+            self.history.as_ref(),
+            h,
+        );
+        // each obstacle's anchor: the same combination of its placements at tₙ and tₙ₋₁
+        let (wn, wp) = anchor.weights;
+        let t_prev = self.history.as_ref().map_or(self.time, |p| p.t);
+        let obstacle_anchors: Vec<[f64; 3]> = self
+            .obstacle_motions
+            .iter()
+            .map(|m| {
+                let (a, b) = (m.position(self.time), m.position(t_prev));
+                std::array::from_fn(|c| wn * a[c] + wp * b[c])
+            })
+            .collect();
+        let xt = anchor.xt.clone();
         let held = self.held_targets(t1);
         let mut x = xn.clone();
         let springs = if s.handle_stiffness.is_some() {
@@ -753,16 +772,20 @@ impl Simulation {
             }
             vec![]
         };
-        let lagged = self.lagged(&xn, h, t1)?;
+        let lagged = self.lagged(&xn, &anchor.xb, anchor.h, t1, &obstacle_anchors)?;
+        let order = anchor.order();
         let tg = Target {
-            h,
+            h: anchor.h,
+            step: h,
             time: t1,
-            xt: xt.clone(),
-            xn,
+            xt: anchor.xt,
+            xn: anchor.xb,
+            xp: anchor.xp,
+            order,
             springs,
             lagged,
         };
-        if !s.quasi_static && s.integrator == Integrator::ImplicitEuler {
+        if !s.quasi_static && s.integrator != Integrator::Linearized {
             let mut guess = x.clone();
             for v in 0..n {
                 if self.pattern.free[v].is_some() {

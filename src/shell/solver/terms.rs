@@ -35,9 +35,18 @@ pub(super) struct Lagged {
 }
 
 impl Simulation {
-    /// The lagged data of a substep of length h starting at `xn` and ending at `t1` (damping and drag only in
-    /// dynamic mode).
-    pub(super) fn lagged(&self, xn: &[f64], h: f64, t1: f64) -> Result<Lagged, ShellError> {
+    /// The lagged data of a substep starting at `xn` and ending at `t1`, for the effective step `h` and the
+    /// velocity anchor `anchor` (xₙ itself for implicit Euler; [`super::integrator`]) and the obstacles' anchors
+    /// (their placements combined as the anchor combines the cloth's states): geometry from xₙ, velocities
+    /// measured from the anchors (damping and drag only in dynamic mode).
+    pub(super) fn lagged(
+        &self,
+        xn: &[f64],
+        anchor: &[f64],
+        h: f64,
+        t1: f64,
+        obstacle_anchors: &[[f64; 3]],
+    ) -> Result<Lagged, ShellError> {
         let s = &self.settings;
         let dynamic = !s.quasi_static;
         let mut damping = std::sync::Arc::new(Vec::new());
@@ -89,7 +98,10 @@ impl Simulation {
                 .iter()
                 .map(|st| {
                     let p = |a: usize| std::array::from_fn(|k| xn[3 * st.v[a] + k]);
-                    dissipation::drag_face([p(0), p(1), p(2)], st.rest.area)
+                    let b = |a: usize| std::array::from_fn(|k| anchor[3 * st.v[a] + k]);
+                    let mut face = dissipation::drag_face([p(0), p(1), p(2)], st.rest.area)?;
+                    face.xn = [b(0), b(1), b(2)];
+                    Some(face)
                 })
                 .collect()
         } else {
@@ -106,7 +118,7 @@ impl Simulation {
                     let pr = self.obstacle_proximity(i, p, self.time);
                     let pen = s.thickness - pr.d;
                     if pen > 0.0 {
-                        let (o0, o1) = (motion.position(self.time), motion.position(t1));
+                        let (o0, o1) = (obstacle_anchors[i], motion.position(t1));
                         friction.push((
                             FrictionContact {
                                 vertex: v,
