@@ -7,6 +7,7 @@ impl Scene {
     /// limits [`MAX_STEPS`], [`MAX_GRAVITY`], [`MAX_NEWTON`]); errors name the field.
     pub(super) fn validate(&self, file: &str) -> Result<(), ShellError> {
         self.validate_times(file)?;
+        self.validate_solver(file)?;
         self.validate_physics(file)?;
         self.validate_geometry(file)
     }
@@ -78,7 +79,54 @@ impl Scene {
         Ok(())
     }
 
-    /// Gravity (bounded by [`MAX_GRAVITY`]), drag, the model's scales, the solver and the contact parameters.
+    /// The solver's settings: force tolerance, iteration, halving and substep limits, the time tolerance.
+    fn validate_solver(&self, file: &str) -> Result<(), ShellError> {
+        let bad = |field: &str, msg: String| Err(ShellError::scene(file, field, msg));
+        if self.solver.force_tol.is_nan() || self.solver.force_tol <= 0.0 {
+            return bad(
+                "solver.force_tol",
+                format!("must be positive, got {}", self.solver.force_tol),
+            );
+        }
+        if self.solver.max_newton > MAX_NEWTON {
+            return bad(
+                "solver.max_newton",
+                format!(
+                    "{} is more than the limit of {MAX_NEWTON}",
+                    self.solver.max_newton
+                ),
+            );
+        }
+        if self.solver.max_halvings > MAX_HALVINGS {
+            return bad(
+                "solver.max_halvings",
+                format!(
+                    "{} is more than the limit of {MAX_HALVINGS}",
+                    self.solver.max_halvings
+                ),
+            );
+        }
+        if !(1..=MAX_SUBSTEPS).contains(&self.solver.substeps) {
+            return bad(
+                "solver.substeps",
+                format!(
+                    "must be a whole number from 1 to {MAX_SUBSTEPS}, got {}",
+                    self.solver.substeps
+                ),
+            );
+        }
+        if let Some(tol) = self.solver.time_tol {
+            if !(tol > 0.0 && tol.is_finite()) {
+                return bad(
+                    "solver.time_tol",
+                    format!("must be a positive length (m) or null, got {tol}"),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Gravity (bounded by [`MAX_GRAVITY`]), drag, the model's scales and the contact parameters.
     fn validate_physics(&self, file: &str) -> Result<(), ShellError> {
         let bad = |field: &str, msg: String| Err(ShellError::scene(file, field, msg));
         let g = self.gravity;
@@ -113,21 +161,6 @@ impl Scene {
         if let Some(Err((key, msg))) = m.collapse_barrier.map(|f| f.check()) {
             return bad(&format!("model.collapse_barrier.{key}"), msg);
         }
-        if self.solver.force_tol.is_nan() || self.solver.force_tol <= 0.0 {
-            return bad(
-                "solver.force_tol",
-                format!("must be positive, got {}", self.solver.force_tol),
-            );
-        }
-        if self.solver.max_newton > MAX_NEWTON {
-            return bad(
-                "solver.max_newton",
-                format!(
-                    "{} is more than the limit of {MAX_NEWTON}",
-                    self.solver.max_newton
-                ),
-            );
-        }
         let w = &self.wind;
         for (f, v) in [
             ("damping", self.damping),
@@ -149,32 +182,6 @@ impl Scene {
                 return bad(
                     "handle_stiffness",
                     format!("must be a positive stiffness (N/m) or null, got {k}"),
-                );
-            }
-        }
-        if self.solver.max_halvings > MAX_HALVINGS {
-            return bad(
-                "solver.max_halvings",
-                format!(
-                    "{} is more than the limit of {MAX_HALVINGS}",
-                    self.solver.max_halvings
-                ),
-            );
-        }
-        if !(1..=MAX_SUBSTEPS).contains(&self.solver.substeps) {
-            return bad(
-                "solver.substeps",
-                format!(
-                    "must be a whole number from 1 to {MAX_SUBSTEPS}, got {}",
-                    self.solver.substeps
-                ),
-            );
-        }
-        if let Some(tol) = self.solver.time_tol {
-            if !(tol > 0.0 && tol.is_finite()) {
-                return bad(
-                    "solver.time_tol",
-                    format!("must be a positive length (m) or null, got {tol}"),
                 );
             }
         }

@@ -289,6 +289,47 @@ pub struct Simulation {
 /// The state and the local PSD Hessians assembled there.
 type DampingCache = (Vec<f64>, std::sync::Arc<Vec<[[f64; NDOF]; NDOF]>>);
 
+/// How the substeps of a step are chosen: the longest substep dt (the step over `substeps`), the smallest
+/// (dt / 2^`max_halvings`) and the accuracy tolerance (none in quasi-static mode).
+struct SubstepPlan {
+    dt: f64,
+    h_min: f64,
+    tol: Option<f64>,
+}
+
+impl SubstepPlan {
+    fn new(s: &Settings) -> SubstepPlan {
+        let dt = s.dt / f64::from(s.substeps);
+        SubstepPlan {
+            dt,
+            h_min: dt / f64::from(1u32 << s.max_halvings),
+            tol: s.time_tol.filter(|_| !s.quasi_static),
+        }
+    }
+
+    /// The next substep's length for the `wanted` one and the time `remaining` in the step: under `time_tol`,
+    /// the last two substeps of a step share what is left instead of ending with a sliver (a very short substep
+    /// after a long one makes the held vertices' inertia jump).
+    fn length(&self, wanted: f64, remaining: f64) -> f64 {
+        if self.tol.is_some() && remaining > wanted && remaining < 2.0 * wanted {
+            0.5 * remaining
+        } else {
+            wanted.min(remaining)
+        }
+    }
+}
+
+/// What a step's substeps did, for its report.
+#[derive(Default)]
+struct Tally {
+    newton: usize,
+    substeps: usize,
+    rejected: usize,
+    dt_min: f64,
+    max_shift: f64,
+    error_max: f64,
+}
+
 /// Per-substep constants of the potential ([`integrator`]'s scheme constants).
 struct Target {
     /// the effective step ĥ of the inertia and dissipation terms (the substep length for implicit Euler)
@@ -508,118 +549,129 @@ impl Simulation {
     pub fn step(&mut self) -> Result<StepReport, ShellError> {
         let start = Instant::now();
         let t_end = self.time + self.settings.dt;
-        // the longest substep: the step divided into `substeps`
-        let dt = self.settings.dt / f64::from(self.settings.substeps);
+        let plan = SubstepPlan::new(&self.settings);
         let step = self.steps + 1;
-        let h_min = dt / f64::from(1u32 << self.settings.max_halvings);
-        let tol = self
-            .settings
-            .time_tol
-            .filter(|_| !self.settings.quasi_static);
-        let (mut newton, mut substeps, mut rejected, mut dt_min) = (0, 0, 0, self.settings.dt);
-        let (mut max_shift, mut error_max): (f64, f64) = (0.0, 0.0);
+        let mut tally = Tally {
+            dt_min: self.settings.dt,
+            ..Tally::default()
+        };
         let mut last: Option<(Minimum, Target)> = None;
         // the step ends when the remaining time is a round-off fraction of dt
-        while t_end - self.time > 1e-9 * dt {
-            let remaining = t_end - self.time;
-            let wanted = match tol {
-                None => dt / f64::from(1u32 << self.level),
+        while t_end - self.time > 1e-9 * plan.dt {
+            let wanted = match plan.tol {
+                None => plan.dt / f64::from(1u32 << self.level),
                 Some(_) => self.h_next,
             };
-            // under `time_tol`, the last two substeps of a step share what is left instead of ending with a
-            // sliver (a very short substep after a long one makes the held vertices' inertia jump)
-            let h = if tol.is_some() && remaining > wanted && remaining < 2.0 * wanted {
-                0.5 * remaining
-            } else {
-                wanted.min(remaining)
-            };
+            let h = plan.length(wanted, t_end - self.time);
             match self.substep(h, step)? {
                 Substep::Done(done) => {
-                    let (mut m, tg) = *done;
-                    let err = self.substep_error(&m.x, &tg);
-                    if let Some(tol) = tol {
-                        let factor = 0.9 * (tol / err).powf(1.0 / f64::from(tg.order + 1));
-                        if err > tol && h > h_min * (1.0 + 1e-9) {
-                            // too inaccurate: retry shorter (the Newton work counts)
-                            newton += m.newton;
-                            rejected += 1;
-                            self.h_next = (h * factor.max(0.2)).max(h_min);
-                            continue;
-                        }
-                        let grown = h * factor.min(2.0);
-                        self.h_next = if h < wanted {
-                            grown.max(self.h_next)
-                        } else {
-                            grown
-                        }
-                        .clamp(h_min, dt);
+                    let (m, tg) = *done;
+                    if let Some(done) = self.conclude(m, tg, h, wanted, &plan, &mut tally) {
+                        last = Some(done);
                     }
-                    error_max = error_max.max(err);
-                    let local = std::mem::take(&mut m.asm.local);
-                    self.damping_cache =
-                        (!local.is_empty()).then(|| (m.x.clone(), std::sync::Arc::new(local)));
-                    newton += m.newton;
-                    substeps += 1;
-                    dt_min = dt_min.min(h);
-                    max_shift = max_shift.max(m.max_shift);
-                    self.accept(&m, &tg);
-                    self.streak += 1;
-                    if self.level > 0 && self.streak >= 2 {
-                        self.level -= 1;
-                        self.streak = 0;
-                    }
-                    last = Some((m, tg));
                 }
                 Substep::Retry {
                     error,
                     residual,
-                    newton: n,
+                    newton,
                 } => {
-                    newton += n;
+                    tally.newton += newton;
                     self.streak = 0;
-                    let exhausted = match tol {
+                    let exhausted = match plan.tol {
                         None => self.level >= self.settings.max_halvings,
-                        Some(_) => h <= h_min * (1.0 + 1e-9),
+                        Some(_) => h <= plan.h_min * (1.0 + 1e-9),
                     };
                     if exhausted {
                         return Err(error.unwrap_or(ShellError::StepFailed {
                             step,
                             time: self.time,
-                            halvings: match tol {
+                            halvings: match plan.tol {
                                 None => self.level,
-                                Some(_) => (dt / h).log2().round() as u32,
+                                Some(_) => (plan.dt / h).log2().round() as u32,
                             },
                             dt: h,
                             residual,
-                            newton: n,
+                            newton,
                         }));
                     }
                     self.level += 1;
-                    self.h_next = (h / 2.0).max(h_min);
+                    self.h_next = (h / 2.0).max(plan.h_min);
                 }
             }
         }
         self.time = t_end;
         self.steps += 1;
         let (m, _) = last.expect("a step of positive length takes a substep");
+        self.report(m, &tally, start)
+    }
+
+    /// A converged substep of length h (the controller asked for `wanted`): under `time_tol` rejected when its
+    /// estimated error is too large (`None`, the next length set), else accepted, with the next length set and
+    /// the tally updated. Returns the accepted minimum and its constants.
+    fn conclude(
+        &mut self,
+        mut m: Minimum,
+        tg: Target,
+        h: f64,
+        wanted: f64,
+        plan: &SubstepPlan,
+        tally: &mut Tally,
+    ) -> Option<(Minimum, Target)> {
+        let err = self.substep_error(&m.x, &tg);
+        if let Some(tol) = plan.tol {
+            let factor = 0.9 * (tol / err).powf(1.0 / f64::from(tg.order + 1));
+            if err > tol && h > plan.h_min * (1.0 + 1e-9) {
+                // too inaccurate: retry shorter (the Newton work counts)
+                tally.newton += m.newton;
+                tally.rejected += 1;
+                self.h_next = (h * factor.max(0.2)).max(plan.h_min);
+                return None;
+            }
+            let grown = h * factor.min(2.0);
+            // a substep shortened only to end the step does not shrink the next one
+            self.h_next = if h < wanted {
+                grown.max(self.h_next)
+            } else {
+                grown
+            }
+            .clamp(plan.h_min, plan.dt);
+        }
+        tally.error_max = tally.error_max.max(err);
+        let local = std::mem::take(&mut m.asm.local);
+        self.damping_cache = (!local.is_empty()).then(|| (m.x.clone(), std::sync::Arc::new(local)));
+        tally.newton += m.newton;
+        tally.substeps += 1;
+        tally.dt_min = tally.dt_min.min(h);
+        tally.max_shift = tally.max_shift.max(m.max_shift);
+        self.accept(&m, &tg);
+        self.streak += 1;
+        if self.level > 0 && self.streak >= 2 {
+            self.level -= 1;
+            self.streak = 0;
+        }
+        Some((m, tg))
+    }
+
+    /// The report of a finished step whose last substep ended at `m` (errors when an energy is not finite).
+    fn report(&self, m: Minimum, tally: &Tally, start: Instant) -> Result<StepReport, ShellError> {
         let (ek, eg, eo) = self.energies();
         for (what, v) in [
             ("kinetic energy", ek),
             ("gravitational energy", eg),
             ("obstacle energy", eo),
         ] {
-            check_finite(step, t_end, what, v)?;
+            check_finite(self.steps, self.time, what, v)?;
         }
         let handle_forces = self.handle_forces(&m.g_full);
         let asm = m.asm;
         Ok(StepReport {
             step: self.steps,
             time: self.time,
-            newton,
-            substeps,
-            dt_min,
-            rejected,
-            error_estimate: error_max,
+            newton: tally.newton,
+            substeps: tally.substeps,
+            dt_min: tally.dt_min,
+            rejected: tally.rejected,
+            error_estimate: tally.error_max,
             residual: m.residual,
             converged: m.converged,
             energy_elastic: asm.energy,
@@ -627,7 +679,7 @@ impl Simulation {
             energy_gravity: eg,
             energy_obstacles: eo,
             handle_forces,
-            shift: max_shift,
+            shift: tally.max_shift,
             wall: start.elapsed().as_secs_f64(),
             strain_min: asm.zmin,
             strain_max: asm.zmax,

@@ -1,0 +1,239 @@
+#!/usr/bin/env python3
+"""Accuracy against wall time of the cloth solver's time integration, by self-convergence.
+
+For each scene, runs `hylc simulate SCENE --duration D --out OUT/<scene>/<config>` for a set of integrator settings
+(fixed substeps of implicit Euler and BDF2, `--time-tol` with both, the original's linearised scheme with its
+`frame_steps`), and compares every run's per-frame handle force (the sum of |F| over the held sets) and elastic
+energy with a reference run of the same scene with a much smaller step (BDF2, dt/REF_SUBSTEPS). Writes a markdown
+table (per scene and configuration: force RMS error over the frames from 0.1 s relative to the reference's RMS
+force, the largest relative energy error over the frames from 0.05 s, the force error at the last frame, substeps,
+Newton iterations, wall time per simulated second) and a PNG per scene (error against wall time).
+
+Resumable: a run whose folder holds `done.json` is not repeated (delete the folder to rerun it). The runs are
+serial (each uses both cores).
+
+Usage:
+  validation/time_study.py [--hylc target/release/hylc] [--out out/time_study]
+      [--results docs/time-study.md] [--plots docs/time-study] [--scenes basket_stretchX,...] [--configs a,b]
+      [--list]
+
+The scenes are the original's ARCSim files under ../shared/data/arcsim-hylc/tests/2D/conf; without that folder the
+script stops with a message.
+"""
+
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CONF = os.path.join(ROOT, "..", "shared", "data", "arcsim-hylc", "tests", "2D", "conf")
+
+# scene: (simulated duration, the original's frame_steps)
+SCENES = {
+    "basket_stretchX": (0.5, 80),
+    "rib_stretchY": (0.3, 80),
+    "stock_stretchX": (0.4, 80),
+    "honey_drapeX": (0.4, 100),
+}
+
+REF_SUBSTEPS = 16  # the reference: BDF2 with dt / 16 (1/960 s for the originals' frame time)
+
+# name: (flags, label)
+CONFIGS = {
+    "ie-1": ([], "implicit Euler, dt"),
+    "ie-2": (["--substeps", "2"], "implicit Euler, dt/2"),
+    "ie-4": (["--substeps", "4"], "implicit Euler, dt/4"),
+    "ie-8": (["--substeps", "8"], "implicit Euler, dt/8"),
+    "bdf2-1": (["--integrator", "bdf2"], "BDF2, dt"),
+    "bdf2-2": (["--integrator", "bdf2", "--substeps", "2"], "BDF2, dt/2"),
+    "bdf2-4": (["--integrator", "bdf2", "--substeps", "4"], "BDF2, dt/4"),
+    "ie-tol-1e-4": (["--time-tol", "1e-4"], "implicit Euler, τ 1e-4 m"),
+    "ie-tol-1e-5": (["--time-tol", "1e-5"], "implicit Euler, τ 1e-5 m"),
+    "bdf2-tol-1e-4": (["--integrator", "bdf2", "--time-tol", "1e-4"], "BDF2, τ 1e-4 m"),
+    "bdf2-tol-1e-5": (["--integrator", "bdf2", "--time-tol", "1e-5"], "BDF2, τ 1e-5 m"),
+    "bdf2-tol-1e-6": (["--integrator", "bdf2", "--time-tol", "1e-6"], "BDF2, τ 1e-6 m"),
+    "linearized": (None, "linearised (original's), frame_steps"),
+}
+
+
+def die(msg):
+    print(f"time_study.py: {msg}", file=sys.stderr)
+    sys.exit(2)
+
+
+def flags_of(config, scene):
+    flags, _ = CONFIGS[config]
+    if flags is None:  # the original's scheme with its own substeps
+        return ["--integrator", "linearized", "--substeps", str(SCENES[scene][1])]
+    return flags
+
+
+def run(hylc, scene, config, out, flags):
+    """Run one configuration (unless done) and return its done.json record."""
+    d = os.path.join(out, scene, config)
+    done = os.path.join(d, "done.json")
+    if os.path.exists(done):
+        with open(done) as f:
+            return json.load(f)
+    duration = SCENES[scene][0]
+    cmd = [hylc, "simulate", os.path.join(CONF, scene + ".json"), "--quiet", "--duration", str(duration),
+           "--out", d] + flags
+    print(f"{scene} {config}: {' '.join(flags) or '(defaults)'}", flush=True)
+    t0 = time.time()
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.time() - t0
+    if p.returncode != 0:
+        lines = [l for l in p.stderr.splitlines() if "warning" not in l]
+        print(f"  exit {p.returncode}: {lines[-1] if lines else ''}", flush=True)
+    rec = {"scene": scene, "config": config, "flags": flags, "exit": p.returncode, "wall": wall,
+           "duration": duration}
+    os.makedirs(d, exist_ok=True)
+    with open(done, "w") as f:
+        json.dump(rec, f)
+    return rec
+
+
+def frames(out, scene, config):
+    """[(time, force, energy, substeps, newton)] per frame of a run's log."""
+    path = os.path.join(out, scene, config, "log.jsonl")
+    rows = []
+    try:
+        with open(path) as f:
+            for n, line in enumerate(f, 1):
+                try:
+                    r = json.loads(line)
+                except json.JSONDecodeError as e:
+                    die(f"{path}:{n}: not a JSON line ({e})")
+                force = sum(math.sqrt(sum(c * c for c in v)) for _, v in r.get("handle_forces", []))
+                rows.append((r["time"], force, r["energy_elastic"], r["substeps"], r["newton"]))
+    except FileNotFoundError:
+        return []
+    return rows
+
+
+def compare(run_rows, ref_rows):
+    """Force RMS error (relative to the reference's RMS force) from 0.1 s, the largest relative energy error from
+    0.05 s and the relative force error at the last frame; None when the run is incomplete."""
+    if not run_rows or len(run_rows) != len(ref_rows):
+        return None
+    df, rf, de = [], [], []
+    for (t, f, e, _, _), (tr, fr, er, _, _) in zip(run_rows, ref_rows):
+        if abs(t - tr) > 1e-9:
+            die(f"frame times differ: {t} against the reference's {tr}")
+        if t >= 0.1 - 1e-9:
+            df.append((f - fr) ** 2)
+            rf.append(fr ** 2)
+        if t >= 0.05 - 1e-9 and er != 0:
+            de.append(abs(e - er) / abs(er))
+    force_rms = math.sqrt(sum(df) / sum(rf)) if rf and sum(rf) > 0 else float("nan")
+    last = run_rows[-1][1], ref_rows[-1][1]
+    last_err = abs(last[0] - last[1]) / abs(last[1]) if last[1] else float("nan")
+    return force_rms, max(de) if de else float("nan"), last_err
+
+
+def plot(out_png, scene, points):
+    try:
+        import matplotlib
+    except ImportError:
+        subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--user", "matplotlib"], check=False)
+        import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for family, marker in [("implicit Euler", "o"), ("BDF2", "s"), ("linearised", "^")]:
+        pts = [(w, e, lab) for w, e, lab in points if lab.startswith(family)]
+        if pts:
+            ax.loglog([p[0] for p in pts], [p[1] for p in pts], marker, label=family)
+            for w, e, lab in pts:
+                ax.annotate(lab.split(", ", 1)[-1], (w, e), fontsize=7, xytext=(3, 3),
+                            textcoords="offset points")
+    ax.set_xlabel("wall time per simulated second (s, 2 cores)")
+    ax.set_ylabel("handle force RMS error (relative, frames from 0.1 s)")
+    ax.set_title(f"2D/{scene}: error against cost (reference: BDF2, dt/{REF_SUBSTEPS})")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out_png, dpi=110)
+    plt.close(fig)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--hylc", default=os.path.join(ROOT, "target", "release", "hylc"))
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "time_study"))
+    ap.add_argument("--results", default=os.path.join(ROOT, "docs", "time-study.md"))
+    ap.add_argument("--plots", default=os.path.join(ROOT, "docs", "time-study"))
+    ap.add_argument("--scenes", default=",".join(SCENES))
+    ap.add_argument("--configs", default=",".join(CONFIGS))
+    ap.add_argument("--list", action="store_true", help="print the scenes and configurations and exit")
+    a = ap.parse_args()
+    if a.list:
+        for s, (d, k) in SCENES.items():
+            print(f"scene {s}: {d} s, frame_steps {k}")
+        for c, (f, lab) in CONFIGS.items():
+            print(f"config {c}: {lab}")
+        return
+    scenes = [s for s in a.scenes.split(",") if s]
+    configs = [c for c in a.configs.split(",") if c]
+    for s in scenes:
+        if s not in SCENES:
+            die(f"--scenes: unknown scene {s!r} (one of {', '.join(SCENES)})")
+    for c in configs:
+        if c not in CONFIGS:
+            die(f"--configs: unknown configuration {c!r} (one of {', '.join(CONFIGS)})")
+    if not os.path.isdir(CONF):
+        die(f"{CONF}: the original's scenes are not there (the study needs ../shared)")
+    if not os.path.exists(a.hylc):
+        die(f"{a.hylc}: no such binary (cargo build --release)")
+    lines = [
+        "# Time integration: accuracy against cost",
+        "",
+        f"Written by `validation/time_study.py`. Reference per scene: BDF2 with dt/{REF_SUBSTEPS} (fixed substeps).",
+        "Force: the sum of |F| over the held sets per frame; its error is the RMS over the frames from 0.1 s",
+        "relative to the reference's RMS force. Energy: the largest relative error of the elastic energy over the",
+        "frames from 0.05 s. Cost: wall time per simulated second on 2 cores (the same machine and session for all",
+        "rows of a scene).",
+        "",
+    ]
+    os.makedirs(a.plots, exist_ok=True)
+    for s in scenes:
+        ref = run(a.hylc, s, "reference", a.out, ["--integrator", "bdf2", "--substeps", str(REF_SUBSTEPS)])
+        ref_rows = frames(a.out, s, "reference")
+        lines += [f"## 2D/{s} ({SCENES[s][0]} s)", "",
+                  "| configuration | force RMS error | energy max error | last-frame force error | substeps | "
+                  "Newton iterations | wall s per simulated s | exit |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+        points = []
+        ref_sub = sum(r[3] for r in ref_rows)
+        ref_newton = sum(r[4] for r in ref_rows)
+        lines.append(f"| reference (BDF2, dt/{REF_SUBSTEPS}) | — | — | — | {ref_sub} | {ref_newton} | "
+                     f"{ref['wall'] / ref['duration']:.1f} | {ref['exit']} |")
+        for c in configs:
+            rec = run(a.hylc, s, c, a.out, flags_of(c, s))
+            rows = frames(a.out, s, c)
+            cmp_ = compare(rows, ref_rows) if ref["exit"] == 0 else None
+            per_s = rec["wall"] / rec["duration"]
+            label = CONFIGS[c][1]
+            if cmp_ is None:
+                lines.append(f"| {label} | — | — | — | — | — | {per_s:.1f} | {rec['exit']} |")
+                continue
+            f_rms, e_max, f_last = cmp_
+            lines.append(f"| {label} | {f_rms:.2%} | {e_max:.2%} | {f_last:.2%} | {sum(r[3] for r in rows)} | "
+                         f"{sum(r[4] for r in rows)} | {per_s:.1f} | {rec['exit']} |")
+            points.append((per_s, f_rms, label))
+        lines.append("")
+        if points:
+            png = os.path.join(a.plots, f"{s}.png")
+            plot(png, s, points)
+            lines += [f"![{s}]({os.path.relpath(png, os.path.dirname(os.path.abspath(a.results)))})", ""]
+    with open(a.results, "w") as f:
+        f.write("\n".join(lines))
+    print(f"wrote {a.results}")
+
+
+if __name__ == "__main__":
+    main()
