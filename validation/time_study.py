@@ -4,10 +4,10 @@
 For each scene, runs `hylc simulate SCENE --duration D --out OUT/<scene>/<config>` for a set of integrator settings
 (fixed substeps of implicit Euler and BDF2, `--time-tol` with both, the original's linearised scheme with its
 `frame_steps`), and compares every run's per-frame handle force (the sum of |F| over the held sets) and elastic
-energy with a reference run of the same scene with a much smaller step (BDF2, dt/REF_SUBSTEPS). Writes a markdown
+energy with a reference run of the same scene with a much smaller step (BDF2, dt/32; --ref-substeps). Writes a markdown
 table (per scene and configuration: force RMS error over the frames from 0.1 s relative to the reference's RMS
 force, the largest relative energy error over the frames from 0.05 s, the force error at the last frame, substeps,
-Newton iterations, wall time per simulated second) and a PNG per scene (error against wall time).
+Newton iterations, CPU and wall time per simulated second) and a PNG per scene (error against CPU time).
 
 Resumable: a run whose folder holds `done.json` is not repeated (delete the folder to rerun it). The runs are
 serial (each uses both cores).
@@ -25,6 +25,7 @@ import argparse
 import json
 import math
 import os
+import resource
 import subprocess
 import sys
 import time
@@ -40,7 +41,7 @@ SCENES = {
     "honey_drapeX": (0.4, 100),
 }
 
-REF_SUBSTEPS = 16  # the reference: BDF2 with dt / 16 (1/960 s for the originals' frame time)
+REF_SUBSTEPS = 32  # the reference: BDF2 with dt / 32 (1/1916 s for the originals' frame time); --ref-substeps
 
 # name: (flags, label)
 CONFIGS = {
@@ -84,12 +85,15 @@ def run(hylc, scene, config, out, flags):
            "--out", d] + flags
     print(f"{scene} {config}: {' '.join(flags) or '(defaults)'}", flush=True)
     t0 = time.time()
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     p = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.time() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
     if p.returncode != 0:
         lines = [l for l in p.stderr.splitlines() if "warning" not in l]
         print(f"  exit {p.returncode}: {lines[-1] if lines else ''}", flush=True)
-    rec = {"scene": scene, "config": config, "flags": flags, "exit": p.returncode, "wall": wall,
+    rec = {"scene": scene, "config": config, "flags": flags, "exit": p.returncode, "wall": wall, "cpu": cpu,
            "duration": duration}
     os.makedirs(d, exist_ok=True)
     with open(done, "w") as f:
@@ -135,11 +139,13 @@ def compare(run_rows, ref_rows):
     return force_rms, max(de) if de else float("nan"), last_err
 
 
-def plot(out_png, scene, points):
+def plot(out_png, scene, points, ref_substeps):
     try:
         import matplotlib
     except ImportError:
-        subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "--user", "matplotlib"], check=False)
+        subprocess.run([sys.executable, "-m", "pip", "install", "--quiet", "matplotlib"], check=False)
+        import importlib
+        importlib.invalidate_caches()
         import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -151,9 +157,9 @@ def plot(out_png, scene, points):
             for w, e, lab in pts:
                 ax.annotate(lab.split(", ", 1)[-1], (w, e), fontsize=7, xytext=(3, 3),
                             textcoords="offset points")
-    ax.set_xlabel("wall time per simulated second (s, 2 cores)")
+    ax.set_xlabel("CPU time per simulated second (s)")
     ax.set_ylabel("handle force RMS error (relative, frames from 0.1 s)")
-    ax.set_title(f"2D/{scene}: error against cost (reference: BDF2, dt/{REF_SUBSTEPS})")
+    ax.set_title(f"2D/{scene}: error against cost (reference: BDF2, dt/{ref_substeps})")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
@@ -169,6 +175,8 @@ def main():
     ap.add_argument("--plots", default=os.path.join(ROOT, "docs", "time-study"))
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--configs", default=",".join(CONFIGS))
+    ap.add_argument("--ref-substeps", type=int, default=REF_SUBSTEPS,
+                    help=f"the reference's fixed substeps per frame (BDF2; default {REF_SUBSTEPS})")
     ap.add_argument("--list", action="store_true", help="print the scenes and configurations and exit")
     a = ap.parse_args()
     if a.list:
@@ -192,43 +200,46 @@ def main():
     lines = [
         "# Time integration: accuracy against cost",
         "",
-        f"Written by `validation/time_study.py`. Reference per scene: BDF2 with dt/{REF_SUBSTEPS} (fixed substeps).",
+        f"Written by `validation/time_study.py`. Reference per scene: BDF2 with dt/{a.ref_substeps} (fixed substeps).",
         "Force: the sum of |F| over the held sets per frame; its error is the RMS over the frames from 0.1 s",
         "relative to the reference's RMS force. Energy: the largest relative error of the elastic energy over the",
-        "frames from 0.05 s. Cost: wall time per simulated second on 2 cores (the same machine and session for all",
-        "rows of a scene).",
+        "frames from 0.05 s. Cost: CPU time (user + system, both cores) and wall time per simulated second; the",
+        "CPU time is the steadier figure when other work shares the machine.",
         "",
     ]
     os.makedirs(a.plots, exist_ok=True)
     for s in scenes:
-        ref = run(a.hylc, s, "reference", a.out, ["--integrator", "bdf2", "--substeps", str(REF_SUBSTEPS)])
-        ref_rows = frames(a.out, s, "reference")
+        ref_name = f"reference-{a.ref_substeps}"
+        ref = run(a.hylc, s, ref_name, a.out, ["--integrator", "bdf2", "--substeps", str(a.ref_substeps)])
+        ref_rows = frames(a.out, s, ref_name)
         lines += [f"## 2D/{s} ({SCENES[s][0]} s)", "",
                   "| configuration | force RMS error | energy max error | last-frame force error | substeps | "
-                  "Newton iterations | wall s per simulated s | exit |",
-                  "| --- | --- | --- | --- | --- | --- | --- | --- |"]
+                  "Newton iterations | CPU s per simulated s | wall s per simulated s | exit |",
+                  "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
         points = []
         ref_sub = sum(r[3] for r in ref_rows)
         ref_newton = sum(r[4] for r in ref_rows)
-        lines.append(f"| reference (BDF2, dt/{REF_SUBSTEPS}) | — | — | — | {ref_sub} | {ref_newton} | "
+        lines.append(f"| reference (BDF2, dt/{a.ref_substeps}) | — | — | — | {ref_sub} | {ref_newton} | "
+                     f"{ref.get('cpu', float('nan')) / ref['duration']:.1f} | "
                      f"{ref['wall'] / ref['duration']:.1f} | {ref['exit']} |")
         for c in configs:
             rec = run(a.hylc, s, c, a.out, flags_of(c, s))
             rows = frames(a.out, s, c)
             cmp_ = compare(rows, ref_rows) if ref["exit"] == 0 else None
             per_s = rec["wall"] / rec["duration"]
+            cpu_s = rec.get("cpu", float("nan")) / rec["duration"]
             label = CONFIGS[c][1]
             if cmp_ is None:
-                lines.append(f"| {label} | — | — | — | — | — | {per_s:.1f} | {rec['exit']} |")
+                lines.append(f"| {label} | — | — | — | — | — | {cpu_s:.1f} | {per_s:.1f} | {rec['exit']} |")
                 continue
             f_rms, e_max, f_last = cmp_
             lines.append(f"| {label} | {f_rms:.2%} | {e_max:.2%} | {f_last:.2%} | {sum(r[3] for r in rows)} | "
-                         f"{sum(r[4] for r in rows)} | {per_s:.1f} | {rec['exit']} |")
-            points.append((per_s, f_rms, label))
+                         f"{sum(r[4] for r in rows)} | {cpu_s:.1f} | {per_s:.1f} | {rec['exit']} |")
+            points.append((cpu_s, f_rms, label))
         lines.append("")
         if points:
             png = os.path.join(a.plots, f"{s}.png")
-            plot(png, s, points)
+            plot(png, s, points, a.ref_substeps)
             lines += [f"![{s}]({os.path.relpath(png, os.path.dirname(os.path.abspath(a.results)))})", ""]
     with open(a.results, "w") as f:
         f.write("\n".join(lines))

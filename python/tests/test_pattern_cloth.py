@@ -77,7 +77,8 @@ def test_simulate_equals_the_cli_log(tmp_path, cli):
     log = [json.loads(line) for line in (out / "log.jsonl").read_text().splitlines()]
     r = hylc.simulate("stretch-x", duration=0.05)
     assert len(r["step"]) == len(log) == r["summary"]["steps"]
-    for key in ["time", "newton", "residual", "energy_elastic", "energy_kinetic", "energy_gravity"]:
+    for key in ["time", "newton", "residual", "energy_elastic", "energy_kinetic", "energy_gravity", "rejected",
+                "error_estimate"]:
         np.testing.assert_allclose(r[key], [e[key] for e in log], rtol=1e-9, atol=1e-300)
     np.testing.assert_allclose(r["strain_max"], [e["strain_max"] for e in log], rtol=1e-9, atol=1e-15)
     for name, forces in r["handle_forces"].items():
