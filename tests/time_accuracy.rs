@@ -95,14 +95,31 @@ fn tighter_tolerances_follow_the_reference_more_closely() {
 /// ARCSim's linearised implicit Euler (`"integrator": "linearized"`): one Newton step per substep, `substeps`
 /// equal substeps per step; a consistent scheme, so with 16 substeps per frame its handle force on the coarse
 /// stretch-x follows the implicit-Euler reference with dt/64 as implicit Euler with 16 fixed substeps does
-/// (measured relative RMS 2.0e-2 against 1.8e-2).
+/// (measured relative RMS 1.8e-2 for both). With air drag (ARCSim's wind, density 7) the step must linearise
+/// the drag about the current velocity: linearised about zero velocity (a step from xₙ), the quadratic drag
+/// drops out of the step and the elastic energy converges to another solution (on the original's
+/// basket_stretchX 34 % above the limit at 0.083 s); here the largest relative energy error over the frames from
+/// 0.05 s stays below 3 %.
 #[test]
 fn the_linearized_scheme_takes_one_newton_step_per_substep() {
     let mut s = coarse("stretch-x", 0.02, 0.2);
     s.damping = 1e-3;
+    s.wind.density = 7.0;
     let mut fine = s.clone();
     fine.dt = s.dt / 64.0;
-    let reference: Vec<f64> = forces(&fine).into_iter().skip(63).step_by(64).collect();
+    let fine_log = reports(&fine);
+    let reference: Vec<f64> = fine_log
+        .iter()
+        .skip(63)
+        .step_by(64)
+        .map(|r| r.handle_forces[1].1[0])
+        .collect();
+    let energies: Vec<f64> = fine_log
+        .iter()
+        .skip(63)
+        .step_by(64)
+        .map(|r| r.energy_elastic)
+        .collect();
     s.solver.integrator = hylc::shell::solver::Integrator::Linearized;
     s.solver.substeps = 16;
     let log = reports(&s);
@@ -113,8 +130,15 @@ fn the_linearized_scheme_takes_one_newton_step_per_substep() {
     let e2: f64 = f.iter().zip(&reference).map(|(a, b)| (a - b).powi(2)).sum();
     let r2: f64 = reference.iter().map(|b| b * b).sum();
     let rms = (e2 / r2).sqrt();
-    eprintln!("linearized, 16 substeps: relative RMS {rms:.3e}");
-    assert!(rms < 0.05, "relative RMS {rms:.3e}");
+    let energy = log
+        .iter()
+        .zip(&energies)
+        .filter(|(r, _)| r.time >= 0.05 - 1e-9)
+        .map(|(r, e)| (r.energy_elastic - e).abs() / e)
+        .fold(0.0, f64::max);
+    eprintln!("linearized, 16 substeps: force relative RMS {rms:.3e}, energy max {energy:.3e}");
+    assert!(rms < 0.05, "force relative RMS {rms:.3e}");
+    assert!(energy < 0.03, "energy relative error {energy:.3e}");
 }
 
 /// BDF2 is second order: on the coarse stretch-x over 0.2 s, against a BDF2 reference with dt/64, halving the

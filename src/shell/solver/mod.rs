@@ -22,6 +22,29 @@
 //! the end of the step). A step that fails at the smallest substep ends the run with
 //! [`ShellError::StepFailed`].
 //!
+//! **Integrators.** [`Integrator::ImplicitEuler`] (the default) minimises Φ to the force tolerance in every
+//! substep; [`Integrator::Bdf2`] minimises the same potential with BDF2's constants (second order; [`integrator`]
+//! gives them and its error estimate). [`Integrator::Linearized`] is the original simulator's (ARCSim's)
+//! linearised implicit Euler: exactly one Newton step on Φ with the PSD option's Hessian and no line search, from
+//! the inertial prediction x̃ = xₙ + h vₙ, so that every force is linearised about the current velocity vₙ:
+//! (M + h(h + c) K)(vₙ₊₁ − vₙ) = h F(x̃, vₙ), the Baraff–Witkin step with the forces evaluated at the predicted
+//! position instead of at xₙ (the two differ by O(h²) per substep). Starting from xₙ instead would linearise the
+//! velocity-dependent forces about zero velocity: the quadratic air drag would vanish from the step (its gradient
+//! and Hessian are zero at zero relative velocity), and on the original's `basket_stretchX` the elastic energy
+//! then converged (20, 80 and 320 substeps alike) to a solution 34 % above the implicit-Euler and BDF2 limit at
+//! 0.083 s. With `substeps` = ARCSim's `frame_steps` it takes the original's steps; its residual is logged, not
+//! driven to zero. `substeps` = k divides every step into k equal substeps before any adaptive halving.
+//!
+//! **Accuracy.** Every converged substep of a dynamic run estimates its local error (m, the largest over the free
+//! vertices; [`integrator`]): for implicit Euler ½ |x − x̃|, the distance between its position and the
+//! second-order trapezoidal rule's, h (vₙ₊₁ − vₙ)/2 (exactly h² |g|/2 in free fall); for BDF2 8/23 of the distance
+//! to an explicit second-order predictor. The log reports the largest estimate of a step (`error_estimate`). With
+//! `time_tol` = τ the substep length is chosen by it: a substep with e > τ is rejected and retried with
+//! h · max(0.2, 0.9 (τ/e)^(1/(p+1))) (p the scheme's order; not below dt / 2^`max_halvings`, where it is accepted
+//! as it is), an accepted one sets the next h to h · min(2, 0.9 (τ/e)^(1/(p+1))) (at most dt; a substep shortened
+//! only to end the step does not shrink it; when less than two substeps are left, the last two share them), and
+//! Newton failures halve h as without τ.
+//!
 //! Boundary conditions: pinned vertices keep their initial positions; handle vertices follow keyframed
 //! translations ([`Motion`]: piecewise linear or cubic Hermite in time, held after the last key), evaluated at
 //! the end of each substep. By default both are hard constraints (dof elimination); with a handle stiffness k
@@ -837,7 +860,7 @@ impl Simulation {
             springs,
             lagged,
         };
-        if !s.quasi_static && s.integrator != Integrator::Linearized {
+        if !s.quasi_static {
             let mut guess = x.clone();
             for v in 0..n {
                 if self.pattern.free[v].is_some() {
@@ -854,8 +877,8 @@ impl Simulation {
     }
 
     /// ARCSim's linearised implicit Euler (module documentation, "Integrators"): one Newton step on Φ from `x`
-    /// (xₙ, held vertices at their targets) with the PSD option's Hessian and no line search; the result counts
-    /// as converged, with the residual force it leaves.
+    /// (the inertial prediction x̃, held vertices at their targets) with the PSD option's Hessian and no line
+    /// search; the result counts as converged, with the residual force it leaves.
     fn linearized(&self, mut x: Vec<f64>, tg: &Target) -> Result<Minimum, ShellError> {
         let (asm, g_full) = self.gradient_hessian(&x, tg)?;
         let (gf, _) = self.free_gradient(&g_full);
