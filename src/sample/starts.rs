@@ -24,13 +24,12 @@ use std::collections::HashMap;
 use std::sync::atomic::Ordering;
 
 /// Which starts each sample is solved from (`hylc sample --starts`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Starts {
     /// The warm start along the chain only (today's records, bit for bit).
     #[default]
     Warm,
     /// The warm start and the cold start (reference state); the lowest converged Ψ̄ is kept.
-    #[value(name = "warm+cold")]
     WarmCold,
     /// Warm and cold, and where they disagree the reversed chain (starts from the steps that continue a sample).
     All,
