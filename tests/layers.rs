@@ -279,7 +279,7 @@ fn sibling_imports() -> BTreeMap<ModPath, BTreeMap<(String, String), String>> {
         let text = std::fs::read_to_string(f).unwrap();
         for (line, target) in resolved_paths(&text, &here) {
             let d = here.iter().zip(&target).take_while(|(a, b)| a == b).count();
-            if d < here.len() && d < target.len() && modules.contains(&target[..=d].to_vec()) {
+            if d < here.len() && d < target.len() && modules.contains(&target[..=d]) {
                 edges
                     .entry(here[..d].to_vec())
                     .or_default()
