@@ -2,6 +2,11 @@
 """Structure metrics of the crate's source tree, for a refactoring issue's before/after report.
 
 usage: python3 validation/code_metrics.py [--rev REV] [--json]
+       python3 validation/code_metrics.py --max-lines N
+
+With --max-lines N (the check `.ci/run` makes), the script lists every `fn` item with a body in src/ and
+python/src/ (methods, nested fns and test fns included) longer than N lines, as `path:line: item (L lines)`, and
+exits 1 if there is any, 0 otherwise. The report below is not printed then.
 
 With --rev, the tree is read from git at REV (`git ls-tree -r --name-only REV src`, `git show REV:path`; nothing is
 checked out); without it, the working tree. Only `src/` is read, so `tests/`, `benches/` and `proptests/` never count.
@@ -269,6 +274,12 @@ def skip_to_body(toks, match, k):
 
 def module_info(path):
     """(is_bin, module path parts, depth below the crate root, directory holding its child module files)."""
+    if path.startswith("python/src/"):  # the Python module's crate: no bin, its own root
+        rel = path[len("python/src/") :]
+        parts = [] if rel == "lib.rs" else rel[: -len(".rs")].split("/")
+        if parts and parts[-1] == "mod":
+            parts = parts[:-1]
+        return False, parts, len(parts), None
     rel = path[len("src/") :]
     if rel.startswith("bin/"):
         parts = rel[len("bin/") : -len(".rs")].split("/")
@@ -929,11 +940,45 @@ def markdown(r):
     return "\n".join(out)
 
 
+def long_functions(max_lines):
+    """Every `fn` with a body in src/ and python/src/ of the working tree (tests included) over max_lines lines."""
+    found, warnings = [], []
+    for top in ("src", "python/src"):
+        for dirpath, dirnames, filenames in os.walk(os.path.join(ROOT, top)):
+            dirnames.sort()
+            for f in sorted(filenames):
+                if not f.endswith(".rs"):
+                    continue
+                full = os.path.join(dirpath, f)
+                rel = os.path.relpath(full, ROOT).replace(os.sep, "/")
+                with open(full, encoding="utf-8") as fh:
+                    info = analyse_file(rel, fh.read(), warnings)
+                found += [fn for fn in info["functions"] if fn["lines"] is not None and fn["lines"] > max_lines]
+    return found, warnings
+
+
+def check_max_lines(max_lines):
+    found, warnings = long_functions(max_lines)
+    for x in warnings:
+        print(f"warning: {x}", file=sys.stderr)
+    for f in found:
+        print(f"{f['file']}:{f['line']}: {f['qual']} ({f['lines']} lines)")
+    if found:
+        print(f"{len(found)} function(s) over {max_lines} lines: split them into helpers", file=sys.stderr)
+        return 1
+    print(f"no function over {max_lines} lines in src/ and python/src/")
+    return 0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rev", help="read the tree at this git revision instead of the working tree")
     ap.add_argument("--json", action="store_true", help="print JSON instead of Markdown")
+    ap.add_argument("--max-lines", type=int, metavar="N",
+                    help="list the functions (tests included, src/ and python/src/) over N lines; exit 1 if any")
     args = ap.parse_args()
+    if args.max_lines is not None:
+        sys.exit(check_max_lines(args.max_lines))
     r = measure(args.rev)
     if args.json:
         json.dump(r, sys.stdout, indent=1, ensure_ascii=False)

@@ -57,6 +57,7 @@ fn log_columns<'py>(py: Python<'py>, log: &[StepReport], d: &Bound<'py, PyDict>)
 /// that fails even at the smallest substep raises `SimulationError`.
 #[pyfunction]
 #[pyo3(signature = (scene, out=None, material=None, duration=None, dt=None, edge=None, time_tol=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
     scene: &str,

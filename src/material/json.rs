@@ -250,6 +250,33 @@ fn sized(obj: &Map<String, Value>, key: &str, path: &str, n: usize, what: &str) 
 
 fn parse_value(root: &Value) -> Res<Material> {
     let top = object(root, "(top level)")?;
+    let density = read_density(top)?;
+    let scale = read_strain_scale(top)?;
+    check_strain_shift(top)?;
+    let coeffs = object(get(top, "coeffs", "(top level)")?, "coeffs")?;
+    let constant = coefficient(
+        number(get(coeffs, "const", "coeffs")?, "coeffs.const")?,
+        "coeffs.const",
+    )?;
+    let terms1d = read_terms1d(coeffs)?;
+    let terms2d = read_terms2d(coeffs)?;
+    let extra = top
+        .iter()
+        .filter(|(k, _)| !matches!(k.as_str(), "density" | "strain scale" | "coeffs"))
+        .map(|(k, v)| (k.clone(), v.clone()))
+        .collect();
+    Ok(Material {
+        density,
+        strain_scale: scale,
+        constant,
+        terms1d,
+        terms2d,
+        extra,
+    })
+}
+
+/// `density` (kg/m²): ≥ 0 and at most [`MAX_DENSITY`].
+fn read_density(top: &Map<String, Value>) -> Res<f64> {
     let density = number(get(top, "density", "(top level)")?, "density")?;
     if density < 0.0 {
         return err("density", format!("must be ≥ 0, is {density}"));
@@ -260,6 +287,11 @@ fn parse_value(root: &Value) -> Res<Material> {
             format!("{density:e} kg/m² is above the largest admissible {MAX_DENSITY:e} kg/m²"),
         );
     }
+    Ok(density)
+}
+
+/// `strain scale`: five positive numbers within [`MIN_STRAIN_SCALE`, `MAX_STRAIN_SCALE`].
+fn read_strain_scale(top: &Map<String, Value>) -> Res<[f64; 5]> {
     let scale = numbers(top, "strain scale", "")?;
     if scale.len() != 5 {
         return err(
@@ -281,6 +313,11 @@ fn parse_value(root: &Value) -> Res<Material> {
             );
         }
     }
+    Ok([scale[0], scale[1], scale[2], scale[3], scale[4]])
+}
+
+/// `strain shift`, if given: only [1, 0, 1, 0, 0] (z holds s = λ − 1).
+fn check_strain_shift(top: &Map<String, Value>) -> Res<()> {
     if let Some(shift) = top.get("strain shift") {
         let v: Vec<f64> = array(shift, "strain shift")?
             .iter()
@@ -296,11 +333,11 @@ fn parse_value(root: &Value) -> Res<Material> {
             );
         }
     }
-    let coeffs = object(get(top, "coeffs", "(top level)")?, "coeffs")?;
-    let constant = coefficient(
-        number(get(coeffs, "const", "coeffs")?, "coeffs.const")?,
-        "coeffs.const",
-    )?;
+    Ok(())
+}
+
+/// `coeffs.1D`: one term per strain component, a knot vector with values and slopes per knot.
+fn read_terms1d(coeffs: &Map<String, Value>) -> Res<Vec<Term1D>> {
     let mut terms1d: Vec<Term1D> = Vec::new();
     for (i, e) in array(get(coeffs, "1D", "coeffs")?, "coeffs.1D")?
         .iter()
@@ -324,6 +361,11 @@ fn parse_value(root: &Value) -> Res<Material> {
             spline: Hermite1D::new(t, p, m),
         });
     }
+    Ok(terms1d)
+}
+
+/// `coeffs.2D`: one term per pair (k0 in-plane, k1 > k0), a knot grid with values and derivatives per node.
+fn read_terms2d(coeffs: &Map<String, Value>) -> Res<Vec<Term2D>> {
     let mut terms2d: Vec<Term2D> = Vec::new();
     for (i, e) in array(get(coeffs, "2D", "coeffs")?, "coeffs.2D")?
         .iter()
@@ -358,19 +400,7 @@ fn parse_value(root: &Value) -> Res<Material> {
             spline: Hermite2D::new(tu, tv, p, mu, mv, muv),
         });
     }
-    let extra = top
-        .iter()
-        .filter(|(k, _)| !matches!(k.as_str(), "density" | "strain scale" | "coeffs"))
-        .map(|(k, v)| (k.clone(), v.clone()))
-        .collect();
-    Ok(Material {
-        density,
-        strain_scale: [scale[0], scale[1], scale[2], scale[3], scale[4]],
-        constant,
-        terms1d,
-        terms2d,
-        extra,
-    })
+    Ok(terms2d)
 }
 
 impl Material {

@@ -88,7 +88,7 @@ pub enum StepRule {
 }
 
 /// Whether the micro solver checks its steps for yarn crossings ([`SolverOptions::crossings`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum CrossingGuard {
     /// Not checked.

@@ -15,7 +15,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 /// Which predictor a chain of solves uses after its first step.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Predictor {
     /// Linear extrapolation from the two previous equilibria ([`MicroProblem::predict`]).

@@ -1,18 +1,18 @@
 //! Sampling (`../shared/design/04-sampling-fitting.md`, section "Sampling plan (C4)"): plans ([`plan`]) and
-//! running them on one pattern ([`run`]): parallel warm-started chains, an append-only sample file, resume,
-//! shards and merging; plans derived from the strains a macro run visited ([`scene`]).
+//! running them on one pattern ([`run`]): parallel warm-started chains, an append-only sample file of
+//! [`record`]s, resume, shards and merging, the starts of a multi-start sample ([`starts`]); plans derived from
+//! the strains a macro run visited ([`scene`]). Sibling modules import one way: `record` ← `starts` ← `run`.
 
 pub mod plan;
+pub mod record;
 pub mod run;
 pub mod scene;
 pub mod starts;
 
 pub use plan::{sample_range, Chain, InPlaneGrid, Plan, PlanError, Sample, Step};
-pub use run::{
-    merge, parse_shard, read_samples, run_plan, run_plan_with, Record, RunOptions, RunSummary,
-    SampleStart, SampleStatus,
-};
-pub use starts::{compare, Comparison, Disagreement, StartKind, StartResult, Starts};
+pub use record::{Record, SampleStart, SampleStatus, StartKind, StartResult};
+pub use run::{merge, parse_shard, read_samples, run_plan, run_plan_with, RunOptions, RunSummary};
+pub use starts::{compare, Comparison, Disagreement, Starts};
 
 use std::path::PathBuf;
 

@@ -19,13 +19,13 @@
 //!   duplicate ids.
 
 use super::plan::{fnv1a64, Plan, Sample, Step};
-use super::starts::{keep, StartKind, StartResult, Starts};
+use super::record::{Record, SampleStart, SampleStatus, StartKind};
+use super::starts::{disagree, keep, kept_index, Solve, Starts, DEFAULT_DISAGREEMENT};
 use super::SampleError;
 use crate::contact::ccd::{net_crossings, Crossing};
 use crate::micro::envelope::strain_derivatives;
 use crate::micro::{CrossingGuard, MacroStrain, MicroProblem, MicroState, Predictor, Status};
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 use std::collections::{HashMap, HashSet};
 use std::fs::{File, OpenOptions};
 use std::io::Write;
@@ -33,111 +33,6 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
-
-/// One line of a sample file.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Record {
-    /// Stable sample id (plan hash + index).
-    pub id: String,
-    /// Index in the plan.
-    pub index: usize,
-    /// Strain z = (s_x, s_a, s_y, Π₀₀, Π₁₁).
-    pub z: [f64; 5],
-    /// Ψ̄ (J/m²) when converged, else null.
-    pub psi: Option<f64>,
-    /// Envelope-theorem stress ∂Ψ̄/∂z (J/m² per unit strain) when converged; a component not defined in the
-    /// solve's family is null.
-    pub stress: Option<[Option<f64>; 5]>,
-    /// `Converged`, `Stalled`, `MaxSteps`, `TimeLimit`, or `Error` (see `error`).
-    pub status: SampleStatus,
-    /// Why the solve could not run (bad strain, overlapping yarns, failed factorisation).
-    pub error: Option<String>,
-    /// Newton steps.
-    pub steps: usize,
-    /// Final ‖g‖∞ (N), null on error.
-    pub gradient_norm: Option<f64>,
-    /// Wall time of the solve (s), its predictor included.
-    pub time: f64,
-    /// How the solve started: `cold`, `warm` (previous equilibrium) or `predicted` (secant predictor); `tangent`
-    /// in files made with the retired tangent predictor.
-    pub start: SampleStart,
-    /// Hash of (pattern, yarn parameters, solver settings), 16 hex digits ([`problem_hash`]).
-    pub problem: String,
-    /// Every start of a multi-start sample ([`RunOptions::starts`]; issue 19, item 1); empty (omitted) when the
-    /// sample was solved from one start.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub starts: Vec<StartResult>,
-    /// Which of `starts` the record's `psi`, `stress`, `status` and `steps` are (omitted with one start).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub kept: Option<StartKind>,
-    /// Yarn crossings along the kept solve's Newton path that do not cancel (`--crossings count|reject`;
-    /// omitted when not checked): a solve with crossings ended in another fabric, so it is no sample
-    /// ([`Record::converged_psi`]).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub crossings: Option<usize>,
-}
-
-impl Record {
-    /// The same solve result as `other` (strain, status, Ψ̄ bitwise, stress): a repeated id with another result
-    /// is a conflict that `merge` and `fit` refuse.
-    pub fn same_result(&self, other: &Record) -> bool {
-        self.z == other.z
-            && self.status == other.status
-            && self.psi.map(f64::to_bits) == other.psi.map(f64::to_bits)
-            && self.stress == other.stress
-    }
-
-    /// Ψ̄ when the sample counts as converged: status `Converged`, a finite Ψ̄ and no yarn crossings along its
-    /// path ([`Record::crossings`]). A `Stalled`, `MaxSteps` or `TimeLimit` record may carry the Ψ̄ of its last
-    /// iterate, which is not an equilibrium, and a solve that pulled yarns through each other found an
-    /// equilibrium of another fabric: neither is a sample (the fit counts them as excluded).
-    pub fn converged_psi(&self) -> Option<f64> {
-        self.psi.filter(|v| {
-            self.status == SampleStatus::Converged
-                && v.is_finite()
-                && self.crossings.unwrap_or(0) == 0
-        })
-    }
-}
-
-/// How a sample's solve ended: the solver's [`Status`], or `Error` when it could not run.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum SampleStatus {
-    Converged,
-    Stalled,
-    MaxSteps,
-    TimeLimit,
-    Error,
-}
-
-impl From<Status> for SampleStatus {
-    fn from(s: Status) -> Self {
-        match s {
-            Status::Converged => SampleStatus::Converged,
-            Status::Stalled => SampleStatus::Stalled,
-            Status::MaxSteps => SampleStatus::MaxSteps,
-            Status::TimeLimit => SampleStatus::TimeLimit,
-        }
-    }
-}
-
-/// How a sample's solve started.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SampleStart {
-    /// From the reference state.
-    Cold,
-    /// From the previous equilibrium of its chain.
-    Warm,
-    /// From the secant predictor along its chain.
-    Predicted,
-    /// From the tangent predictor y* + (dy*/dz)·Δz of the step it continues: read in sample files made before the
-    /// predictor was retired (`docs/notes/retired-micro-solver-rules.md`), no longer written.
-    Tangent,
-    /// From the kept equilibrium of a step that continues it (the reversed chain; `--starts all`).
-    Reverse,
-}
 
 /// Options of [`run_plan`].
 #[derive(Clone, Debug, Default)]
@@ -605,6 +500,74 @@ impl PlanRun<'_> {
         }
         (self.progress)(n, self.todo);
         true
+    }
+}
+
+impl PlanRun<'_> {
+    /// `--starts all` on one chain: the forward pass (warm and cold starts, the chain continuing from its warm
+    /// equilibria), then the reversed pass (a sample whose starts [`disagree`] is also started from the kept
+    /// equilibrium of every step continuing it, latest first, so a lower branch found late propagates back up),
+    /// then the chain's unfinished records in order.
+    pub(super) fn chain_all(&self, steps: &[Step]) {
+        let id = |i: usize| &self.samples[steps[i].sample].id;
+        if (0..steps.len()).all(|i| self.done.contains(id(i))) {
+            return;
+        }
+        let rel = self.opts.disagreement.unwrap_or(DEFAULT_DISAGREEMENT);
+        let mut states: Vec<Option<MicroState>> = vec![None; steps.len()];
+        let mut solves: Vec<Vec<Solve>> = Vec::with_capacity(steps.len());
+        for (i, step) in steps.iter().enumerate() {
+            if self.stop.load(Ordering::Relaxed) {
+                return;
+            }
+            let sample = &self.samples[step.sample];
+            let (warm, ws) = self.solve(steps, step, &states, sample, false);
+            states[i] = ws.clone();
+            solves.push(if warm.start == SampleStart::Cold {
+                vec![(StartKind::Cold, warm, ws)]
+            } else {
+                let (cold, cs) = self.solve(steps, step, &states, sample, true);
+                vec![(StartKind::Warm, warm, ws), (StartKind::Cold, cold, cs)]
+            });
+        }
+        let mut kept: Vec<Option<MicroState>> = vec![None; steps.len()];
+        for i in (0..steps.len()).rev() {
+            if disagree(&solves[i], rel) {
+                let sample = &self.samples[steps[i].sample];
+                for j in (i + 1..steps.len()).filter(|&j| steps[j].from == Some(i)) {
+                    if let Some(s) = kept[j].as_ref() {
+                        let strain = MacroStrain(sample.z);
+                        let crossed = self.start_crossings(s, s, &strain);
+                        if self.rejects(&crossed) {
+                            continue;
+                        }
+                        let (r, st) =
+                            self.solve_from(sample, Some(s), SampleStart::Reverse, 0.0, crossed);
+                        solves[i].push((StartKind::Reverse, r, st));
+                    }
+                }
+            }
+            let k = kept_index(solves[i].iter().map(|s| &s.1));
+            kept[i] = solves[i][k].2.clone();
+        }
+        for (i, v) in solves.into_iter().enumerate() {
+            if self.done.contains(id(i)) {
+                self.replayed.fetch_add(1, Ordering::Relaxed);
+                continue;
+            }
+            if self
+                .opts
+                .limit
+                .is_some_and(|l| self.slots.fetch_add(1, Ordering::SeqCst) >= l)
+            {
+                self.stop.store(true, Ordering::Relaxed);
+                return;
+            }
+            let record = keep(v.into_iter().map(|(k, r, _)| (k, r)).collect());
+            if !self.write(&record) {
+                return;
+            }
+        }
     }
 }
 

@@ -16,21 +16,17 @@
 //! - [`compare`] checks two sample files of one plan for agreement (e.g. warm-first against cold-first): the
 //!   samples converged in both whose Ψ̄ differ by more than a relative tolerance, with both energies.
 
-use super::plan::Step;
-use super::run::{PlanRun, Record, SampleStart, SampleStatus};
-use crate::micro::{MacroStrain, MicroState};
-use serde::{Deserialize, Serialize};
+use super::record::{Record, StartKind, StartResult};
+use crate::micro::MicroState;
 use std::collections::HashMap;
-use std::sync::atomic::Ordering;
 
 /// Which starts each sample is solved from (`hylc sample --starts`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Starts {
     /// The warm start along the chain only (today's records, bit for bit).
     #[default]
     Warm,
     /// The warm start and the cold start (reference state); the lowest converged Ψ̄ is kept.
-    #[value(name = "warm+cold")]
     WarmCold,
     /// Warm and cold, and where they disagree the reversed chain (starts from the steps that continue a sample).
     All,
@@ -48,32 +44,6 @@ impl std::fmt::Display for Starts {
             Starts::All => "all",
         })
     }
-}
-
-/// Which start a [`StartResult`] is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum StartKind {
-    /// The chain's start: its predecessor's equilibrium, extrapolated by the predictor (the record's `start`
-    /// says how when this start is kept).
-    Warm,
-    /// The reference state.
-    Cold,
-    /// The kept equilibrium of a step that continues this one along the chain (`--starts all`).
-    Reverse,
-}
-
-/// One start of a multi-start sample: Ψ̄ when converged (else null), status and Newton steps.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct StartResult {
-    pub kind: StartKind,
-    pub psi: Option<f64>,
-    pub status: SampleStatus,
-    pub steps: usize,
-    /// Yarn crossings of this start's path that do not cancel (omitted when not checked).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub crossings: Option<usize>,
 }
 
 /// Combine the solves of one sample from several starts (in order of preference, non-empty): the kept record is
@@ -101,7 +71,7 @@ pub fn keep(solves: Vec<(StartKind, Record)>) -> Record {
 
 /// The index of the record [`keep`] keeps: the converged one with the lowest Ψ̄ (the first of equal ones), else 0.
 /// A start whose path crossed yarns does not count as converged ([`Record::converged_psi`]).
-fn kept_index<'a>(records: impl Iterator<Item = &'a Record>) -> usize {
+pub(super) fn kept_index<'a>(records: impl Iterator<Item = &'a Record>) -> usize {
     let mut best: Option<(usize, f64)> = None;
     for (i, r) in records.enumerate() {
         if let Some(p) = r.converged_psi() {
@@ -113,9 +83,12 @@ fn kept_index<'a>(records: impl Iterator<Item = &'a Record>) -> usize {
     best.map_or(0, |(i, _)| i)
 }
 
+/// One start's solve: its kind, record and converged state.
+pub(super) type Solve = (StartKind, Record, Option<MicroState>);
+
 /// Whether a sample's warm and cold starts disagree: one converged and the other not, or both converged with Ψ̄
 /// more than `rel` apart ([`relative_difference`]). A sample with one start does not disagree.
-fn disagree(solves: &[Solve], rel: f64) -> bool {
+pub(super) fn disagree(solves: &[Solve], rel: f64) -> bool {
     let psi = |k: StartKind| {
         solves
             .iter()
@@ -126,77 +99,6 @@ fn disagree(solves: &[Solve], rel: f64) -> bool {
         (Some(Some(a)), Some(Some(b))) => relative_difference(a, b) > rel,
         (Some(a), Some(b)) => a.is_some() != b.is_some(),
         _ => false,
-    }
-}
-
-/// One start's solve: its kind, record and converged state.
-type Solve = (StartKind, Record, Option<MicroState>);
-
-impl PlanRun<'_> {
-    /// `--starts all` on one chain: the forward pass (warm and cold starts, the chain continuing from its warm
-    /// equilibria), then the reversed pass (a sample whose starts [`disagree`] is also started from the kept
-    /// equilibrium of every step continuing it, latest first, so a lower branch found late propagates back up),
-    /// then the chain's unfinished records in order.
-    pub(super) fn chain_all(&self, steps: &[Step]) {
-        let id = |i: usize| &self.samples[steps[i].sample].id;
-        if (0..steps.len()).all(|i| self.done.contains(id(i))) {
-            return;
-        }
-        let rel = self.opts.disagreement.unwrap_or(DEFAULT_DISAGREEMENT);
-        let mut states: Vec<Option<MicroState>> = vec![None; steps.len()];
-        let mut solves: Vec<Vec<Solve>> = Vec::with_capacity(steps.len());
-        for (i, step) in steps.iter().enumerate() {
-            if self.stop.load(Ordering::Relaxed) {
-                return;
-            }
-            let sample = &self.samples[step.sample];
-            let (warm, ws) = self.solve(steps, step, &states, sample, false);
-            states[i] = ws.clone();
-            solves.push(if warm.start == SampleStart::Cold {
-                vec![(StartKind::Cold, warm, ws)]
-            } else {
-                let (cold, cs) = self.solve(steps, step, &states, sample, true);
-                vec![(StartKind::Warm, warm, ws), (StartKind::Cold, cold, cs)]
-            });
-        }
-        let mut kept: Vec<Option<MicroState>> = vec![None; steps.len()];
-        for i in (0..steps.len()).rev() {
-            if disagree(&solves[i], rel) {
-                let sample = &self.samples[steps[i].sample];
-                for j in (i + 1..steps.len()).filter(|&j| steps[j].from == Some(i)) {
-                    if let Some(s) = kept[j].as_ref() {
-                        let strain = MacroStrain(sample.z);
-                        let crossed = self.start_crossings(s, s, &strain);
-                        if self.rejects(&crossed) {
-                            continue;
-                        }
-                        let (r, st) =
-                            self.solve_from(sample, Some(s), SampleStart::Reverse, 0.0, crossed);
-                        solves[i].push((StartKind::Reverse, r, st));
-                    }
-                }
-            }
-            let k = kept_index(solves[i].iter().map(|s| &s.1));
-            kept[i] = solves[i][k].2.clone();
-        }
-        for (i, v) in solves.into_iter().enumerate() {
-            if self.done.contains(id(i)) {
-                self.replayed.fetch_add(1, Ordering::Relaxed);
-                continue;
-            }
-            if self
-                .opts
-                .limit
-                .is_some_and(|l| self.slots.fetch_add(1, Ordering::SeqCst) >= l)
-            {
-                self.stop.store(true, Ordering::Relaxed);
-                return;
-            }
-            let record = keep(v.into_iter().map(|(k, r, _)| (k, r)).collect());
-            if !self.write(&record) {
-                return;
-            }
-        }
     }
 }
 
@@ -282,6 +184,7 @@ pub fn compare(a: &[Record], b: &[Record], rel: f64) -> Comparison {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sample::record::{SampleStart, SampleStatus};
 
     fn record(psi: Option<f64>, status: SampleStatus, steps: usize) -> Record {
         Record {

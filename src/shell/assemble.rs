@@ -249,6 +249,17 @@ pub fn assemble_keeping(
     assemble_with(model, stencils, pattern, x, true, exact_too, true)
 }
 
+/// What an assembly computes besides the energy, the gradient and z.
+#[derive(Clone, Copy)]
+struct Wanted {
+    /// the Hessian with the model's PSD option
+    hessian: bool,
+    /// the exact Hessian too (only with `hessian`)
+    exact_too: bool,
+    /// every stencil's local PSD-option Hessian ([`Assembled::local`])
+    keep_local: bool,
+}
+
 fn assemble_with(
     model: &ElementModel,
     stencils: &[Stencil],
@@ -271,72 +282,99 @@ fn assemble_with(
             local: vec![],
         });
     }
+    let want = Wanted {
+        hessian,
+        exact_too,
+        keep_local,
+    };
     let nthreads = rayon::current_num_threads().max(1);
     let chunk = stencils.len().div_ceil(nthreads).max(1);
-    let nnz = if hessian { pattern.nnz() } else { 0 };
     let parts: Vec<Option<Assembled>> = stencils
         .par_chunks(chunk)
         .enumerate()
-        .map(|(ci, ss)| {
-            let mut out = Assembled {
-                energy: 0.0,
-                grad: vec![0.0; x.len()],
-                values: vec![0.0; nnz],
-                values_exact: vec![0.0; if exact_too { nnz } else { 0 }],
-                zmin: [f64::INFINITY; 6],
-                zmax: [f64::NEG_INFINITY; 6],
-                z: Vec::with_capacity(ss.len()),
-                local: Vec::with_capacity(if keep_local { ss.len() } else { 0 }),
-            };
-            let mut g = [0.0; NDOF];
-            let mut h = [[0.0; NDOF]; NDOF];
-            let mut hx = [[0.0; NDOF]; NDOF];
-            for (si, s) in ss.iter().enumerate() {
-                let q = gather(s, x);
-                let (e, z) = if exact_too {
-                    model.energy_gradient_hessians(&q, &s.rest, s.flaps, &mut g, &mut hx, &mut h)?
-                } else if hessian {
-                    model.energy_gradient_hessian(&q, &s.rest, s.flaps, &mut g, &mut h)?
-                } else {
-                    model.energy_gradient(&q, &s.rest, s.flaps, &mut g)?
-                };
-                out.energy += e;
-                out.z.push(z);
-                if keep_local {
-                    let mut hl = h;
-                    zero_absent_flaps(&mut hl, s, model.bending);
-                    out.local.push(hl);
-                }
-                for k in 0..6 {
-                    out.zmin[k] = out.zmin[k].min(z[k]);
-                    out.zmax[k] = out.zmax[k].max(z[k]);
-                }
-                for a in 0..6 {
-                    if a >= 3 && !s.flaps[a - 3] {
-                        continue;
-                    }
-                    for k in 0..3 {
-                        out.grad[3 * s.v[a] + k] += g[3 * a + k];
-                    }
-                }
-                if hessian {
-                    let k = ci * chunk + si;
-                    pattern.add_stencil_hessian(&mut out.values, k, s, &h);
-                    if exact_too {
-                        pattern.add_stencil_hessian(&mut out.values_exact, k, s, &hx);
-                    }
-                }
-            }
-            Some(out)
-        })
+        .map(|(ci, ss)| assemble_chunk(model, pattern, x, ss, ci * chunk, want))
         .collect();
-    let mut parts: Vec<Assembled> = parts.into_iter().collect::<Option<Vec<_>>>()?;
+    let parts: Vec<Assembled> = parts.into_iter().collect::<Option<Vec<_>>>()?;
+    Some(sum_parts(parts, keep_local, stencils.len()))
+}
+
+/// One thread's share: the stencils `ss` (the first is stencil number `first`) accumulated into arrays of their
+/// own; `None` if a triangle is degenerate.
+fn assemble_chunk(
+    model: &ElementModel,
+    pattern: &Pattern,
+    x: &[f64],
+    ss: &[Stencil],
+    first: usize,
+    want: Wanted,
+) -> Option<Assembled> {
+    let Wanted {
+        hessian,
+        exact_too,
+        keep_local,
+    } = want;
+    let nnz = if hessian { pattern.nnz() } else { 0 };
+    let mut out = Assembled {
+        energy: 0.0,
+        grad: vec![0.0; x.len()],
+        values: vec![0.0; nnz],
+        values_exact: vec![0.0; if exact_too { nnz } else { 0 }],
+        zmin: [f64::INFINITY; 6],
+        zmax: [f64::NEG_INFINITY; 6],
+        z: Vec::with_capacity(ss.len()),
+        local: Vec::with_capacity(if keep_local { ss.len() } else { 0 }),
+    };
+    let mut g = [0.0; NDOF];
+    let mut h = [[0.0; NDOF]; NDOF];
+    let mut hx = [[0.0; NDOF]; NDOF];
+    for (si, s) in ss.iter().enumerate() {
+        let q = gather(s, x);
+        let (e, z) = if exact_too {
+            model.energy_gradient_hessians(&q, &s.rest, s.flaps, &mut g, &mut hx, &mut h)?
+        } else if hessian {
+            model.energy_gradient_hessian(&q, &s.rest, s.flaps, &mut g, &mut h)?
+        } else {
+            model.energy_gradient(&q, &s.rest, s.flaps, &mut g)?
+        };
+        out.energy += e;
+        out.z.push(z);
+        if keep_local {
+            let mut hl = h;
+            zero_absent_flaps(&mut hl, s, model.bending);
+            out.local.push(hl);
+        }
+        for k in 0..6 {
+            out.zmin[k] = out.zmin[k].min(z[k]);
+            out.zmax[k] = out.zmax[k].max(z[k]);
+        }
+        for a in 0..6 {
+            if a >= 3 && !s.flaps[a - 3] {
+                continue;
+            }
+            for k in 0..3 {
+                out.grad[3 * s.v[a] + k] += g[3 * a + k];
+            }
+        }
+        if hessian {
+            let k = first + si;
+            pattern.add_stencil_hessian(&mut out.values, k, s, &h);
+            if exact_too {
+                pattern.add_stencil_hessian(&mut out.values_exact, k, s, &hx);
+            }
+        }
+    }
+    Some(out)
+}
+
+/// The threads' shares summed into one (in a fixed order: deterministic for a given thread count); z and the
+/// local Hessians concatenated in stencil order.
+fn sum_parts(mut parts: Vec<Assembled>, keep_local: bool, nstencils: usize) -> Assembled {
     let z: Vec<[f64; 6]> = parts.iter().flat_map(|p| p.z.iter().copied()).collect();
     // the first part's local Hessians grow by the others' (moved once, not element by element into a vector
     // that reallocates as it grows)
     let local: Vec<[[f64; NDOF]; NDOF]> = if keep_local {
         let mut all = std::mem::take(&mut parts[0].local);
-        all.reserve_exact(stencils.len() - all.len());
+        all.reserve_exact(nstencils - all.len());
         for p in parts.iter_mut().skip(1) {
             all.append(&mut p.local);
         }
@@ -369,5 +407,5 @@ fn assemble_with(
             total.zmax[k] = total.zmax[k].max(p.zmax[k]);
         }
     }
-    Some(total)
+    total
 }

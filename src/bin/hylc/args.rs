@@ -2,7 +2,7 @@
 
 use clap::ValueEnum;
 use hylc::micro::reference::Construction;
-use hylc::micro::{CrossingGuard, SolverOptions, StepRule};
+use hylc::micro::{CrossingGuard, Predictor, SolverOptions, StepRule};
 use hylc::rod::YarnMaterial;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -24,7 +24,7 @@ pub struct SolverArgs {
     /// through each other rejected (reject); default off (`sample --starts warm+cold|all`: reject). A measured
     /// trade (README, "The crossing guard"): reject keeps every sample in its fabric, at 0.34–1.2× the speed
     #[arg(long, value_enum)]
-    pub crossings: Option<CrossingGuard>,
+    pub crossings: Option<CrossingGuardArg>,
     /// the design's shift rule alone (μ grown until H + μI is positive definite) instead of the default
     /// inertia-controlled steps (the exact constrained Newton step wherever H is positive definite on the
     /// constraint space and the energy follows its quadratic model); reproduces the solver before 5 December
@@ -40,13 +40,54 @@ impl SolverArgs {
             tolerance: self.tolerance,
             max_steps: self.max_steps,
             time_limit: self.time_limit,
-            crossings: self.crossings.unwrap_or_default(),
+            crossings: self.crossings.map(CrossingGuard::from).unwrap_or_default(),
             step_rule: if self.no_inertia {
                 StepRule::Shift
             } else {
                 StepRule::Inertia
             },
             ..Default::default()
+        }
+    }
+}
+
+/// `--crossings` (`hylc::micro::CrossingGuard`; the help of each value is the library variant's).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CrossingGuardArg {
+    /// Not checked.
+    Off,
+    /// Every accepted step (and a chain's start path) is checked and the crossings are reported; the solve is
+    /// unchanged.
+    Count,
+    /// A line-search trial that crosses yarns is rejected (the search backtracks further); a chain's start whose
+    /// path crosses is replaced by the next candidate (predicted, warm, cold).
+    Reject,
+}
+
+impl From<CrossingGuardArg> for CrossingGuard {
+    fn from(c: CrossingGuardArg) -> Self {
+        match c {
+            CrossingGuardArg::Off => CrossingGuard::Off,
+            CrossingGuardArg::Count => CrossingGuard::Count,
+            CrossingGuardArg::Reject => CrossingGuard::Reject,
+        }
+    }
+}
+
+/// `--predictor` of `solve` and `sample` (`hylc::micro::Predictor`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PredictorArg {
+    /// Linear extrapolation from the two previous equilibria ([`MicroProblem::predict`]).
+    Secant,
+    /// The previous equilibrium itself (moved to the new strain at fixed unknowns).
+    None,
+}
+
+impl From<PredictorArg> for Predictor {
+    fn from(p: PredictorArg) -> Self {
+        match p {
+            PredictorArg::Secant => Predictor::Secant,
+            PredictorArg::None => Predictor::None,
         }
     }
 }

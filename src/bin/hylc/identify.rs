@@ -5,14 +5,14 @@ use crate::args::{parse_list, SolverArgs, YarnArgs};
 use crate::strain::load_pattern_noted;
 use anyhow::{anyhow, bail};
 use hylc::material::Material;
+use hylc::micro::SolverOptions;
 use hylc::pattern::Pattern;
+use hylc::rod::YarnMaterial;
 use hylc::strain::StrainComponent;
-use hylc::validation::grid::{grid_coords, GridData, AXIS_LEN, GRID_LEN};
+use hylc::validation::grid::{grid_coords, GridData, GRID_LEN};
 use hylc::validation::identify::conventions::{check_conventions, ConventionRow};
-use hylc::validation::identify::held_out::{
-    curve_points, held_out, study, HeldOut, StudyCurve, STUDY_PARAMETERS,
-};
-use hylc::validation::identify::plot::{plot_panels, Series};
+use hylc::validation::identify::held_out::{curve_points, held_out, study, HeldOut};
+use hylc::validation::identify::plot::{plot_study, write_plots};
 use hylc::validation::identify::residuals::{CurveTarget, GridTarget};
 use hylc::validation::identify::{
     identify, stored_state_pattern, Breakdown, Identification, IdentifyError, IdentifyOptions,
@@ -83,134 +83,33 @@ pub struct Args {
 /// `hylc identify`: exit code 2 on bad input, 3 when a solve the residuals need does not converge at the start.
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let yarn = a.yarn.material()?;
-    let sets: Vec<String> = parse_list(&a.residuals, "residuals")?;
-    for s in &sets {
-        if !["a", "b", "c"].contains(&s.as_str()) {
-            bail!("--residuals: unknown set {s:?} (expected a, b or c)");
-        }
-    }
-    let weights: Vec<f64> = parse_list(&a.weights, "weights")?;
-    if weights.len() != 3 || weights.iter().any(|w| !(w.is_finite() && *w > 0.0)) {
-        bail!(
-            "--weights: expected three positive numbers (a, b, c), got {:?}",
-            a.weights
-        );
-    }
-    let on = |s: &str| sets.iter().any(|x| x == s);
-    let mut free = [true; 5];
-    for f in &a.fix {
-        let k = UNKNOWN_KEYS.iter().position(|k| k == f).ok_or_else(|| {
-            anyhow!(
-                "--fix: unknown {f:?} (expected one of {})",
-                UNKNOWN_KEYS.join(", ")
-            )
-        })?;
-        free[k] = false;
-    }
-    let stem = Path::new(&a.pattern)
-        .file_stem()
-        .map_or("pattern".to_string(), |s| s.to_string_lossy().into_owned());
-    let out = a
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("out/identify").join(&stem));
-    let loaded = Pattern::load_pyp(&a.pattern).ok();
-    let pattern = match (&loaded, a.file_periods) {
-        (Some((p, _)), true) => p.clone(),
-        _ => load_pattern_noted(&a.pattern)?,
-    };
-    let stored_pattern = match &loaded {
-        Some((p, warnings)) => stored_state_pattern(p.clone(), !warnings.is_empty(), &yarn)
-            .map_err(|e| {
-                anyhow!(
-                    "{}: equilibrium periods of the stored state: {e}",
-                    a.pattern
-                )
-            })?,
-        None => pattern.clone(),
-    };
-    let file_pattern = loaded.map(|p| p.0).filter(|p| p.periods != pattern.periods);
-    let data = match &a.data {
-        Some(dir) => {
-            let d = GridData::load(dir)?;
-            d.check_pattern(&pattern)
-                .map_err(|e| anyhow!("{} with {}: {e}", a.pattern, dir.display()))?;
-            Some(d)
-        }
-        None if on("b") || a.validate => bail!("--residuals b and --validate need --data DIR"),
-        None => None,
-    };
-    let original = match &a.material {
-        Some(path) => Some(Material::load(path)?),
-        None if on("c") || a.validate => bail!("--residuals c and --validate need --material FILE"),
-        None => None,
-    };
-    if !on("c") && free[0] && free[3] {
-        eprintln!(
-            "note: without residual c nothing fixes the stiffness scale (an equilibrium does not change when every \
-             stiffness scales together): ln Y is held fixed"
-        );
-        free[0] = false;
-    }
+    let mut choice = ResidualChoice::parse(&a)?;
+    let inputs = Inputs::load(&a, &yarn, &choice)?;
+    choice.hold_stiffness_scale();
     let solver = a.solver.options();
-    std::fs::create_dir_all(&out).map_err(|e| anyhow!("{}: cannot create: {e}", out.display()))?;
-
+    let out = &inputs.out;
+    std::fs::create_dir_all(out).map_err(|e| anyhow!("{}: cannot create: {e}", out.display()))?;
     // item 4: conventions first
-    let conventions = match (&data, a.no_conventions) {
+    let conventions = match (&inputs.data, a.no_conventions) {
         (Some(d), false) => {
-            let rows = check_conventions(&pattern, file_pattern.as_ref(), &yarn, &solver, d)
+            let file_pattern = inputs.file_pattern.as_ref();
+            let rows = check_conventions(&inputs.pattern, file_pattern, &yarn, &solver, d)
                 .map_err(|e| anyhow!("{}: conventions check: {e}", a.pattern))?;
             print_conventions(&rows);
             rows
         }
         _ => vec![],
     };
-
-    let grid = match (&data, on("b")) {
-        (Some(d), true) => Some(GridTarget {
-            points: grid_points(d, &a.grid_steps)?,
-            data: d.clone(),
-            weight: weights[1],
-        }),
-        _ => None,
-    };
-    let curve = match (&original, on("c")) {
-        (Some(m), true) => Some(curve_target(
-            m,
-            &a.curve_terms,
-            a.curve_points,
-            pattern.radius,
-            weights[2],
-        )?),
-        _ => None,
-    };
-    let residuals = Residuals {
-        stored: on("a").then(|| StoredTarget {
-            pattern: stored_pattern.clone(),
-            weight: weights[0],
-        }),
-        grid,
-        curve,
-    };
+    let residuals = residuals(&a, &choice, &inputs)?;
     let options = IdentifyOptions {
-        free,
+        free: choice.free,
         max_iterations: a.max_iterations,
         solver: solver.clone(),
         ..Default::default()
     };
-    println!(
-        "{}: {} vertices, r = {:.4e} m; unknowns {}; residuals {}",
-        a.pattern,
-        pattern.len(),
-        pattern.radius,
-        (0..5)
-            .map(|k| format!("{}{}", UNKNOWNS[k], if free[k] { "" } else { " (fixed)" }))
-            .collect::<Vec<_>>()
-            .join(", "),
-        sets.join(",")
-    );
-    let result = identify(&pattern, &yarn, &residuals, &options, &mut print_iteration);
-    let result = match result {
+    print_start(&a.pattern, &inputs.pattern, &choice);
+    let pattern = &inputs.pattern;
+    let result = match identify(pattern, &yarn, &residuals, &options, &mut print_iteration) {
         Ok(r) => r,
         Err(e @ IdentifyError::NotConverged { .. }) => {
             eprintln!("error: {}: {e}", a.pattern);
@@ -221,29 +120,14 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     print_result(&result);
     let yarn_path = out.join("identified.yarn.json");
     result.identified.save_json(&yarn_path)?;
-
     // item 5: the held-out numbers before and after
-    let validation = if a.validate {
-        let d = data.as_ref().expect("checked above");
-        let m = original.as_ref().expect("checked above");
-        let mut rows = Vec::new();
-        for (label, y) in [("start", &result.start), ("identified", &result.identified)] {
-            eprintln!("validation ({label}): full grid and five 1D curves …");
-            let h = held_out(&pattern, y, &solver, Some(d), m, 12, &|| {})
-                .map_err(|e| anyhow!("{}: validation: {e}", a.pattern))?;
-            print_held_out(label, &h);
-            rows.push(h);
-        }
-        Some(rows)
-    } else {
-        None
-    };
-    write_plots(&out, &stem, &result, validation.as_deref())?;
-    let study_curves = match (&original, a.study) {
+    let validation = validate(&a, &inputs, &result, &solver)?;
+    write_plots(out, &inputs.stem, &result, validation.as_deref())?;
+    let study_curves = match (&inputs.original, a.study) {
         (Some(m), true) => {
-            let curves = study(&pattern, &result.identified, &solver, m, 12)
+            let curves = study(pattern, &result.identified, &solver, m, 12)
                 .map_err(|e| anyhow!("{}: study: {e}", a.pattern))?;
-            plot_study(&out, &stem, &curves)?;
+            plot_study(out, &inputs.stem, &curves)?;
             Some(curves)
         }
         (None, true) => bail!("--study needs --material FILE"),
@@ -253,8 +137,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         "pattern": a.pattern,
         "data": a.data,
         "material": a.material,
-        "residuals": sets,
-        "weights": weights,
+        "residuals": choice.sets,
+        "weights": choice.weights,
         "conventions": conventions,
         "identification": result,
         "validation": validation,
@@ -270,6 +154,202 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         out.display()
     );
     Ok(ExitCode::SUCCESS)
+}
+
+/// The residual sets switched on (`--residuals`), their weights and the free unknowns (`--fix`).
+struct ResidualChoice {
+    sets: Vec<String>,
+    weights: Vec<f64>,
+    free: [bool; 5],
+}
+
+impl ResidualChoice {
+    fn parse(a: &Args) -> anyhow::Result<ResidualChoice> {
+        let sets: Vec<String> = parse_list(&a.residuals, "residuals")?;
+        for s in &sets {
+            if !["a", "b", "c"].contains(&s.as_str()) {
+                bail!("--residuals: unknown set {s:?} (expected a, b or c)");
+            }
+        }
+        let weights: Vec<f64> = parse_list(&a.weights, "weights")?;
+        if weights.len() != 3 || weights.iter().any(|w| !(w.is_finite() && *w > 0.0)) {
+            bail!(
+                "--weights: expected three positive numbers (a, b, c), got {:?}",
+                a.weights
+            );
+        }
+        let mut free = [true; 5];
+        for f in &a.fix {
+            let k = UNKNOWN_KEYS.iter().position(|k| k == f).ok_or_else(|| {
+                anyhow!(
+                    "--fix: unknown {f:?} (expected one of {})",
+                    UNKNOWN_KEYS.join(", ")
+                )
+            })?;
+            free[k] = false;
+        }
+        Ok(ResidualChoice {
+            sets,
+            weights,
+            free,
+        })
+    }
+
+    /// Whether the residual set `s` (a, b or c) is on.
+    fn on(&self, s: &str) -> bool {
+        self.sets.iter().any(|x| x == s)
+    }
+
+    /// Without residual c nothing fixes the stiffness scale: ln Y is held fixed (with a note) when both it and
+    /// k_c are free.
+    fn hold_stiffness_scale(&mut self) {
+        if !self.on("c") && self.free[0] && self.free[3] {
+            eprintln!(
+                "note: without residual c nothing fixes the stiffness scale (an equilibrium does not change when \
+                 every stiffness scales together): ln Y is held fixed"
+            );
+            self.free[0] = false;
+        }
+    }
+}
+
+/// What the identification reads: the pattern (with the implied periods unless `--file-periods`), the pattern of
+/// the stored state, the file's pattern when its periods differ, the original's displacements and material, and
+/// the output folder.
+struct Inputs {
+    stem: String,
+    out: PathBuf,
+    pattern: Pattern,
+    stored_pattern: Pattern,
+    file_pattern: Option<Pattern>,
+    data: Option<GridData>,
+    original: Option<Material>,
+}
+
+impl Inputs {
+    fn load(a: &Args, yarn: &YarnMaterial, choice: &ResidualChoice) -> anyhow::Result<Inputs> {
+        let stem = Path::new(&a.pattern)
+            .file_stem()
+            .map_or("pattern".to_string(), |s| s.to_string_lossy().into_owned());
+        let out = a
+            .out
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("out/identify").join(&stem));
+        let loaded = Pattern::load_pyp(&a.pattern).ok();
+        let pattern = match (&loaded, a.file_periods) {
+            (Some((p, _)), true) => p.clone(),
+            _ => load_pattern_noted(&a.pattern)?,
+        };
+        let stored_pattern = match &loaded {
+            Some((p, warnings)) => stored_state_pattern(p.clone(), !warnings.is_empty(), yarn)
+                .map_err(|e| {
+                    anyhow!(
+                        "{}: equilibrium periods of the stored state: {e}",
+                        a.pattern
+                    )
+                })?,
+            None => pattern.clone(),
+        };
+        let file_pattern = loaded.map(|p| p.0).filter(|p| p.periods != pattern.periods);
+        let data = match &a.data {
+            Some(dir) => {
+                let d = GridData::load(dir)?;
+                d.check_pattern(&pattern)
+                    .map_err(|e| anyhow!("{} with {}: {e}", a.pattern, dir.display()))?;
+                Some(d)
+            }
+            None if choice.on("b") || a.validate => {
+                bail!("--residuals b and --validate need --data DIR")
+            }
+            None => None,
+        };
+        let original = match &a.material {
+            Some(path) => Some(Material::load(path)?),
+            None if choice.on("c") || a.validate => {
+                bail!("--residuals c and --validate need --material FILE")
+            }
+            None => None,
+        };
+        Ok(Inputs {
+            stem,
+            out,
+            pattern,
+            stored_pattern,
+            file_pattern,
+            data,
+            original,
+        })
+    }
+}
+
+/// The switched-on residual sets with their targets and weights.
+fn residuals(a: &Args, choice: &ResidualChoice, inputs: &Inputs) -> anyhow::Result<Residuals> {
+    let weights = &choice.weights;
+    let grid = match (&inputs.data, choice.on("b")) {
+        (Some(d), true) => Some(GridTarget {
+            points: grid_points(d, &a.grid_steps)?,
+            data: d.clone(),
+            weight: weights[1],
+        }),
+        _ => None,
+    };
+    let curve = match (&inputs.original, choice.on("c")) {
+        (Some(m), true) => Some(curve_target(
+            m,
+            &a.curve_terms,
+            a.curve_points,
+            inputs.pattern.radius,
+            weights[2],
+        )?),
+        _ => None,
+    };
+    Ok(Residuals {
+        stored: choice.on("a").then(|| StoredTarget {
+            pattern: inputs.stored_pattern.clone(),
+            weight: weights[0],
+        }),
+        grid,
+        curve,
+    })
+}
+
+/// The line before the iterations: the pattern, the unknowns (fixed ones marked) and the residual sets.
+fn print_start(name: &str, pattern: &Pattern, choice: &ResidualChoice) {
+    let free = choice.free;
+    println!(
+        "{}: {} vertices, r = {:.4e} m; unknowns {}; residuals {}",
+        name,
+        pattern.len(),
+        pattern.radius,
+        (0..5)
+            .map(|k| format!("{}{}", UNKNOWNS[k], if free[k] { "" } else { " (fixed)" }))
+            .collect::<Vec<_>>()
+            .join(", "),
+        choice.sets.join(",")
+    );
+}
+
+/// `--validate`: the full grid and the five 1D curves at the start and the identified parameters.
+fn validate(
+    a: &Args,
+    inputs: &Inputs,
+    result: &Identification,
+    solver: &SolverOptions,
+) -> anyhow::Result<Option<Vec<HeldOut>>> {
+    if !a.validate {
+        return Ok(None);
+    }
+    let d = inputs.data.as_ref().expect("checked above");
+    let m = inputs.original.as_ref().expect("checked above");
+    let mut rows = Vec::new();
+    for (label, y) in [("start", &result.start), ("identified", &result.identified)] {
+        eprintln!("validation ({label}): full grid and five 1D curves …");
+        let h = held_out(&inputs.pattern, y, solver, Some(d), m, 12, &|| {})
+            .map_err(|e| anyhow!("{}: validation: {e}", a.pattern))?;
+        print_held_out(label, &h);
+        rows.push(h);
+    }
+    Ok(Some(rows))
 }
 
 /// The compared grid points of residual b: within `steps` index steps of the start point, or all.
@@ -435,185 +515,4 @@ fn print_held_out(label: &str, h: &HeldOut) {
         h.grid_converged.unwrap_or(0),
         curves.join(", ")
     );
-}
-
-/// RMS per axis value of the fitted grid points: (axis value, RMS) per axis.
-fn by_axis(points: &[([f64; 3], f64)]) -> [Vec<(f64, f64)>; 3] {
-    std::array::from_fn(|k| {
-        let mut vals: Vec<f64> = points.iter().map(|p| p.0[k]).collect();
-        vals.sort_by(f64::total_cmp);
-        vals.dedup();
-        vals.iter()
-            .map(|&v| {
-                let sel: Vec<f64> = points
-                    .iter()
-                    .filter(|p| p.0[k] == v)
-                    .map(|p| p.1 * p.1)
-                    .collect();
-                (v, (sel.iter().sum::<f64>() / sel.len() as f64).sqrt())
-            })
-            .collect()
-    })
-}
-
-fn write_plots(
-    out: &Path,
-    stem: &str,
-    r: &Identification,
-    validation: Option<&[HeldOut]>,
-) -> anyhow::Result<()> {
-    let axis_names = ["s_x", "s_a", "s_y"];
-    if !r.before.grid_points.is_empty() {
-        let (b, a) = (
-            by_axis(&r.before.grid_points),
-            by_axis(&r.after.grid_points),
-        );
-        let panels: Vec<(String, String, Vec<Series>)> = (0..3)
-            .map(|k| {
-                (
-                    format!("error by {} (fitted points)", axis_names[k]),
-                    axis_names[k].to_string(),
-                    vec![
-                        Series {
-                            label: "before".into(),
-                            points: b[k].clone(),
-                            colour: 1,
-                            markers: true,
-                        },
-                        Series {
-                            label: "after".into(),
-                            points: a[k].clone(),
-                            colour: 2,
-                            markers: true,
-                        },
-                    ],
-                )
-            })
-            .collect();
-        plot_panels(
-            &out.join("fit_grid_error.png"),
-            &format!("{stem}: RMS position error [r]"),
-            "RMS error [r]",
-            &panels,
-        )
-        .map_err(anyhow::Error::from)?;
-    }
-    if let Some([before, after]) = validation {
-        if let (Some(bx), Some(ax), Some(axes)) =
-            (before.grid_rms_by_axis, after.grid_rms_by_axis, after.axes)
-        {
-            let line = |v: &[f64; AXIS_LEN], k: usize| -> Vec<(f64, f64)> {
-                (0..AXIS_LEN).map(|i| (axes[k][i], v[i])).collect()
-            };
-            let panels: Vec<(String, String, Vec<Series>)> = (0..3)
-                .map(|k| {
-                    (
-                        format!("full grid, by {}", axis_names[k]),
-                        axis_names[k].to_string(),
-                        vec![
-                            Series {
-                                label: "before".into(),
-                                points: line(&bx[k], k),
-                                colour: 1,
-                                markers: false,
-                            },
-                            Series {
-                                label: "after".into(),
-                                points: line(&ax[k], k),
-                                colour: 2,
-                                markers: false,
-                            },
-                        ],
-                    )
-                })
-                .collect();
-            plot_panels(
-                &out.join("grid_error_by_axis.png"),
-                &format!("{stem}: full-grid RMS position error [r]"),
-                "RMS error [r]",
-                &panels,
-            )
-            .map_err(anyhow::Error::from)?;
-        }
-        let panels: Vec<(String, String, Vec<Series>)> = after
-            .curves
-            .iter()
-            .zip(&before.curves)
-            .map(|(a, b)| {
-                let pts = |c: &[f64], s: &[f64]| {
-                    s.iter().copied().zip(c.iter().copied()).collect::<Vec<_>>()
-                };
-                (
-                    format!("f0 + f_{}: after {:.1} %", a.component, 100.0 * a.rel_rms),
-                    a.component.to_string(),
-                    vec![
-                        Series {
-                            label: "original".into(),
-                            points: pts(&a.original, &a.strains),
-                            colour: 0,
-                            markers: false,
-                        },
-                        Series {
-                            label: "ours, start".into(),
-                            points: pts(&b.ours, &b.strains),
-                            colour: 1,
-                            markers: true,
-                        },
-                        Series {
-                            label: "ours, identified".into(),
-                            points: pts(&a.ours, &a.strains),
-                            colour: 2,
-                            markers: true,
-                        },
-                    ],
-                )
-            })
-            .collect();
-        if !panels.is_empty() {
-            plot_panels(
-                &out.join("curves.png"),
-                &format!("{stem}: 1D curves [J/m2]"),
-                "energy density [J/m2]",
-                &panels,
-            )
-            .map_err(anyhow::Error::from)?;
-        }
-    }
-    Ok(())
-}
-
-/// study.png: θ ∂Ψ̄/∂θ along each 1D range, one panel per range, one series per parameter.
-fn plot_study(out: &Path, stem: &str, curves: &[StudyCurve]) -> anyhow::Result<()> {
-    let panels: Vec<(String, String, Vec<Series>)> = curves
-        .iter()
-        .map(|c| {
-            let series = (0..5)
-                .map(|j| Series {
-                    label: format!("d psi / d ln {}", STUDY_PARAMETERS[j]),
-                    points: c
-                        .strains
-                        .iter()
-                        .copied()
-                        .zip(c.dpsi_dlog[j].iter().copied())
-                        .collect(),
-                    colour: j + 1,
-                    markers: false,
-                })
-                .collect();
-            (
-                format!("f0 + f_{}", c.component),
-                c.component.to_string(),
-                series,
-            )
-        })
-        .collect();
-    plot_panels(
-        &out.join("study.png"),
-        &format!(
-            "{stem}: sensitivity of the energy density to the yarn parameters [J/m2 per ln θ]"
-        ),
-        "J/m2",
-        &panels,
-    )
-    .map_err(anyhow::Error::from)
 }

@@ -1,10 +1,10 @@
 //! `hylc sample PATTERN --plan P --out S.jsonl`: a sampling plan on one pattern
 //! (`04-sampling-fitting.md`, section "Sampling plan (C4)"; `hylc::sample`).
 
-use crate::args::{exit, SolverArgs, YarnArgs};
+use crate::args::{exit, PredictorArg, SolverArgs, YarnArgs};
 use crate::printer::sample_bar;
 use crate::strain::load_pattern_noted;
-use hylc::micro::Predictor;
+use clap::ValueEnum;
 use hylc::micro::{CrossingGuard, MicroProblem};
 use hylc::sample::{parse_shard, run_plan_with, RunOptions, Starts};
 use hylc::workflow::inputs::load_plan;
@@ -36,13 +36,13 @@ pub struct Args {
     limit: Option<usize>,
     /// predictor of warm starts along a chain: secant (from the two previous equilibria) or none (the previous
     /// equilibrium itself)
-    #[arg(long, value_enum, default_value_t = Predictor::Secant)]
-    predictor: Predictor,
+    #[arg(long, value_enum, default_value_t = PredictorArg::Secant)]
+    predictor: PredictorArg,
     /// starts of every sample (issue 19, item 1): warm (along the chain), or warm+cold (also from the reference
     /// state, keeping the lowest converged Ψ̄; the record lists every start), or all (where warm and cold
     /// disagree, also from the steps that continue the sample: the chain in reverse)
-    #[arg(long, value_enum, default_value_t = Starts::Warm)]
-    starts: Starts,
+    #[arg(long, value_enum, default_value_t = StartsArg::Warm)]
+    starts: StartsArg,
     /// --starts all: relative difference of the warm and the cold Ψ̄ above which the reversed chain is tried
     #[arg(long, default_value_t = hylc::sample::starts::DEFAULT_DISAGREEMENT)]
     disagreement: f64,
@@ -50,6 +50,28 @@ pub struct Args {
     solver: SolverArgs,
     #[command(flatten)]
     yarn: YarnArgs,
+}
+
+/// `--starts` (`hylc::sample::Starts`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum StartsArg {
+    /// The warm start along the chain only (today's records, bit for bit).
+    Warm,
+    /// The warm start and the cold start (reference state); the lowest converged Ψ̄ is kept.
+    #[value(name = "warm+cold")]
+    WarmCold,
+    /// Warm and cold, and where they disagree the reversed chain (starts from the steps that continue a sample).
+    All,
+}
+
+impl From<StartsArg> for Starts {
+    fn from(s: StartsArg) -> Self {
+        match s {
+            StartsArg::Warm => Starts::Warm,
+            StartsArg::WarmCold => Starts::WarmCold,
+            StartsArg::All => Starts::All,
+        }
+    }
 }
 
 /// `hylc sample`: exit code 3 when a written sample did not converge.
@@ -60,7 +82,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let yarn = a.yarn.material()?;
     let p = load_pattern_noted(pattern)?;
     let mut options = a.solver.options();
-    if a.starts != Starts::Warm && a.solver.crossings.is_none() {
+    let starts = Starts::from(a.starts);
+    if starts != Starts::Warm && a.solver.crossings.is_none() {
         // a start that pulls yarns through each other ends in another fabric (issue 19, item 1)
         options.crossings = CrossingGuard::Reject;
     }
@@ -70,8 +93,8 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         cold,
         shard,
         limit,
-        predictor: a.predictor,
-        starts: a.starts,
+        predictor: a.predictor.into(),
+        starts,
         disagreement: Some(a.disagreement),
     };
     let bar = OnceLock::new();

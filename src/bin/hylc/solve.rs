@@ -1,7 +1,7 @@
 //! `hylc solve PATTERN --z …`: the micro solver on one pattern at one or more strains (`03-homogenization.md`;
 //! `hylc::micro`).
 
-use crate::args::{exit, SolverArgs, YarnArgs};
+use crate::args::{exit, PredictorArg, SolverArgs, YarnArgs};
 use crate::strain::{load_pattern_noted, parse_strain};
 use anyhow::anyhow;
 use hylc::micro::envelope::strain_derivatives;
@@ -28,8 +28,8 @@ pub struct Args {
     #[arg(long)]
     no_predictor: bool,
     /// predictor of warm starts along the chain: secant (from the two previous solutions) or none
-    #[arg(long, value_enum, default_value_t = Predictor::Secant)]
-    predictor: Predictor,
+    #[arg(long, value_enum, default_value_t = PredictorArg::Secant)]
+    predictor: PredictorArg,
     #[command(flatten)]
     solver: SolverArgs,
     #[command(flatten)]
@@ -70,7 +70,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let predictor = if a.no_predictor {
         Predictor::None
     } else {
-        a.predictor
+        a.predictor.into()
     };
     let (cold, json_out) = (a.cold, a.json);
     let p = load_pattern_noted(&a.pattern)?;

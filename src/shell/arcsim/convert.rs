@@ -3,7 +3,7 @@
 
 use super::handlebar::{Handlebar, SIDES};
 use super::json::Node;
-use super::read::{join, Ctx, Key};
+use super::read::{join, Ctx, Fields, Key};
 use crate::shell::motion::{Interpolation, Keyframe, Motion};
 use crate::shell::scene::{
     ContactSpec, HandleSpec, MeshSpec, ModelSpec, ObstacleSpec, OutputSpec, Placement, Scene,
@@ -24,9 +24,66 @@ pub const DEFAULT_OBS_FRICTION: f64 = 0.3;
 const REMESHING: &str =
     "adaptive remeshing is not part of the HYLC model (the cloth keeps its mesh)";
 
-/// Convert the scene `root`; `name` is the produced scene's name.
+/// Convert the scene `root`; `name` is the produced scene's name. The readers below run in the order of the
+/// scene's sections, so that warnings come in that order and the first malformed key is the one reported.
 pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, ShellError> {
-    let top = ctx.fields(
+    let top = read_top(ctx, root)?;
+    let line = root.line;
+    let (material, only_1d) = read_hylc(ctx, &top, line)?;
+    let (dt, duration) = read_time(ctx, &top, line)?;
+    let cloth = read_cloth(ctx, &top, line)?;
+    let wind = read_wind(ctx, top.get("wind").copied())?;
+    let motions = match top.get("motions") {
+        Some(n) => read_motions(ctx, n)?,
+        None => Vec::new(),
+    };
+    let handles = read_handles(ctx, &top, &motions, &cloth)?;
+    let obstacles = match top.get("obstacles") {
+        Some(n) => read_obstacles(ctx, n, &motions)?,
+        None => Vec::new(),
+    };
+    let (gravity, friction) = read_gravity_friction(ctx, &top)?;
+    let contact_default = ContactSpec::default();
+    let (handle_stiffness, thickness) =
+        read_magic(ctx, top.get("magic").copied(), &contact_default)?;
+    Ok(Scene {
+        name: name.to_string(),
+        material,
+        mesh: MeshSpec::Obj {
+            path: cloth.mesh_rel,
+            transform: cloth.transform,
+        },
+        placement: Placement::default(),
+        fabric_angle_deg: 0.0,
+        duration,
+        dt,
+        quasi_static: false,
+        gravity,
+        drag: 0.0,
+        damping: cloth.damping,
+        wind,
+        handle_stiffness: Some(handle_stiffness),
+        model: ModelSpec {
+            only_1d,
+            ..ModelSpec::default()
+        },
+        psd: Psd::Psi,
+        solver: SolverSpec::default(),
+        pins: Vec::new(),
+        handles,
+        obstacles,
+        contact: ContactSpec {
+            thickness,
+            friction,
+            ..contact_default
+        },
+        output: OutputSpec { obj_every: 1 },
+    })
+}
+
+/// The top-level object with its keys checked (warnings for the ignored ones).
+fn read_top<'n>(ctx: &mut Ctx, root: &'n Node) -> Result<Fields<'n>, ShellError> {
+    ctx.fields(
         root,
         "",
         &[
@@ -58,11 +115,12 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
                 Ignored("cloth–cloth friction: there is no cloth self-contact here"),
             ),
         ],
-    )?;
-    let line = root.line;
+    )
+}
 
-    // the HYLC material and model
-    let hylc_node = ctx.required(&top, line, "", "hylc")?;
+/// `hylc`: the HYLC material (its name relative to the scene's folder) and `only1D`.
+fn read_hylc(ctx: &mut Ctx, top: &Fields, line: usize) -> Result<(String, bool), ShellError> {
+    let hylc_node = ctx.required(top, line, "", "hylc")?;
     let hylc = ctx.fields(
         hylc_node,
         "hylc",
@@ -81,10 +139,14 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
         Some(n) => ctx.boolean(n, "hylc.only1D")?,
         None => false,
     };
+    Ok((material, only_1d))
+}
 
-    // time
-    let dt = ctx.positive(ctx.required(&top, line, "", "frame_time")?, "frame_time")?;
-    let duration = ctx.non_negative(ctx.required(&top, line, "", "end_time")?, "end_time")?;
+/// Time: the step `frame_time` and the duration `end_time`; `frame_steps` is checked and warned about (one
+/// implicit step per frame here).
+fn read_time(ctx: &mut Ctx, top: &Fields, line: usize) -> Result<(f64, f64), ShellError> {
+    let dt = ctx.positive(ctx.required(top, line, "", "frame_time")?, "frame_time")?;
+    let duration = ctx.non_negative(ctx.required(top, line, "", "end_time")?, "end_time")?;
     if let Some(n) = top.get("frame_steps") {
         let k = ctx.number(n, "frame_steps")?;
         if !(k >= 1.0 && k.fract() == 0.0) {
@@ -105,9 +167,25 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
             ),
         );
     }
+    Ok((dt, duration))
+}
 
-    // the cloth
-    let cloths_node = ctx.required(&top, line, "", "cloths")?;
+/// The cloth as the scene names it and as the handles select on it.
+struct Cloth {
+    /// the mesh file's name relative to the scene's folder
+    mesh_rel: String,
+    transform: Transform,
+    damping: f64,
+    /// the rest layout, scaled by the transform
+    mesh: Mesh,
+    /// the initial positions, transformed
+    x0: Vec<[f64; 3]>,
+}
+
+/// `cloths`: exactly one, its mesh, transform and damping; the rest layout and the initial state exactly as
+/// `Scene::build` makes them.
+fn read_cloth(ctx: &mut Ctx, top: &Fields, line: usize) -> Result<Cloth, ShellError> {
+    let cloths_node = ctx.required(top, line, "", "cloths")?;
     let cloths = ctx.array(cloths_node, "cloths")?;
     if cloths.len() != 1 {
         return Err(ctx.error(
@@ -138,168 +216,224 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
     };
     let materials = ctx.required(&cloth, c0.line, "cloths[0]", "materials")?;
     let damping = read_materials(ctx, materials)?;
-    // the rest layout and the initial state exactly as `Scene::build` makes them
     let (mut mesh, x) = Mesh::load_obj(&mesh_path)
         .map_err(|e| ctx.error(mesh_node.line, "cloths[0].mesh", e.to_string()))?;
     for r in mesh.rest.iter_mut() {
         *r = r.map(|c| c * transform.scale);
     }
     let x0: Vec<[f64; 3]> = x.into_iter().map(|p| transform.apply(p)).collect();
+    Ok(Cloth {
+        mesh_rel,
+        transform,
+        damping,
+        mesh,
+        x0,
+    })
+}
 
-    // air
-    let wind = match top.get("wind") {
-        None => Wind {
+/// `wind` (air): density, drag and velocity, each with ARCSim's default.
+fn read_wind(ctx: &mut Ctx, node: Option<&Node>) -> Result<Wind, ShellError> {
+    let Some(n) = node else {
+        return Ok(Wind {
             density: DEFAULT_WIND_DENSITY,
             drag: 0.0,
             velocity: [0.0; 3],
+        });
+    };
+    let f = ctx.fields(
+        n,
+        "wind",
+        &[("density", Used), ("drag", Used), ("velocity", Used)],
+    )?;
+    Ok(Wind {
+        density: match f.get("density") {
+            Some(d) => ctx.non_negative(d, "wind.density")?,
+            None => DEFAULT_WIND_DENSITY,
         },
-        Some(n) => {
-            let f = ctx.fields(
-                n,
-                "wind",
-                &[("density", Used), ("drag", Used), ("velocity", Used)],
-            )?;
-            Wind {
-                density: match f.get("density") {
-                    Some(d) => ctx.non_negative(d, "wind.density")?,
-                    None => DEFAULT_WIND_DENSITY,
-                },
-                drag: match f.get("drag") {
-                    Some(d) => ctx.non_negative(d, "wind.drag")?,
-                    None => 0.0,
-                },
-                velocity: match f.get("velocity") {
-                    Some(v) => ctx.numbers::<3>(v, "wind.velocity")?,
-                    None => [0.0; 3],
-                },
-            }
-        }
-    };
+        drag: match f.get("drag") {
+            Some(d) => ctx.non_negative(d, "wind.drag")?,
+            None => 0.0,
+        },
+        velocity: match f.get("velocity") {
+            Some(v) => ctx.numbers::<3>(v, "wind.velocity")?,
+            None => [0.0; 3],
+        },
+    })
+}
 
-    // motions, handlebars (moving strips), handlespheres (fixed)
-    let motions = match top.get("motions") {
-        Some(n) => read_motions(ctx, n)?,
-        None => Vec::new(),
+/// The handles: handlebars (moving strips), handlespheres (fixed or moving balls), node handles, in this order.
+fn read_handles(
+    ctx: &mut Ctx,
+    top: &Fields,
+    motions: &[Motion],
+    cloth: &Cloth,
+) -> Result<Vec<HandleSpec>, ShellError> {
+    let (mut handles, held_by_bars) = match top.get("handlebars") {
+        Some(n) => read_handlebars(ctx, n, motions, cloth)?,
+        None => (Vec::new(), Vec::new()),
     };
-    let mut handles: Vec<HandleSpec> = Vec::new();
-    let mut held_by_bars: Vec<Vec<usize>> = Vec::new();
-    if let Some(n) = top.get("handlebars") {
-        for (i, b) in ctx.array(n, "handlebars")?.iter().enumerate() {
-            let path = format!("handlebars[{i}]");
-            let f = ctx.fields(
-                b,
-                &path,
-                &[
-                    ("side", Used),
-                    ("lengthp", Used),
-                    ("widthp", Used),
-                    ("insetp", Used),
-                    ("motion", Used),
-                ],
-            )?;
-            let req = |k: &str| ctx.required(&f, b.line, &path, k);
-            let side = ctx.index(
-                req("side")?,
-                &join(&path, "side"),
-                4,
-                "0 (left), 1 (bottom), 2 (right) or 3 (top)",
-            )?;
-            let bar = Handlebar {
-                side,
-                lengthp: ctx.fraction(req("lengthp")?, &join(&path, "lengthp"))?,
-                widthp: ctx.fraction(req("widthp")?, &join(&path, "widthp"))?,
-                insetp: ctx.fraction(req("insetp")?, &join(&path, "insetp"))?,
-            };
-            let motion = read_motion_index(ctx, req("motion")?, &path, &motions)?;
-            let (select, held) = bar.selection(&mesh, &x0);
-            if held.is_empty() {
-                return Err(ctx.error(
-                    b.line,
-                    &path,
-                    "selects no vertex of the cloth (no vertex lies strictly inside its strip)",
-                ));
-            }
-            let mut name = SIDES[side].to_string();
-            if handles.iter().any(|h| h.name == name) {
-                name = format!("{name}-{i}");
-            }
-            handles.push(handle(name, select, motion));
-            held_by_bars.push(held);
-        }
-    }
     if let Some(n) = top.get("handlespheres") {
-        for (i, s) in ctx.array(n, "handlespheres")?.iter().enumerate() {
-            let path = format!("handlespheres[{i}]");
-            let f = ctx.fields(
-                s,
-                &path,
-                &[("center", Used), ("radius", Used), ("motion", Used)],
-            )?;
-            let center = ctx.numbers::<3>(
-                ctx.required(&f, s.line, &path, "center")?,
-                &join(&path, "center"),
-            )?;
-            let radius = ctx.positive(
-                ctx.required(&f, s.line, &path, "radius")?,
-                &join(&path, "radius"),
-            )?;
-            let motion = match f.get("motion") {
-                Some(m) => read_motion_index(ctx, m, &path, &motions)?,
-                None => Motion::fixed(),
-            };
-            let sel = Selection::Ball { center, radius };
-            let held = sel.select(&mesh, &x0);
-            if held.is_empty() {
-                return Err(ctx.error(
-                    s.line,
-                    &path,
-                    "selects no vertex of the cloth (none within its radius of its center)",
-                ));
-            }
-            if let Some(j) = held_by_bars
-                .iter()
-                .position(|bar| bar.iter().any(|v| held.contains(v)))
-            {
-                return Err(ctx.error(
-                    s.line,
-                    &path,
-                    format!("holds vertices that handlebars[{j}] moves too"),
-                ));
-            }
-            handles.push(handle(format!("sphere{i}"), sel, motion));
-        }
+        handles.extend(read_handlespheres(ctx, n, motions, cloth, &held_by_bars)?);
     }
     if let Some(n) = top.get("handles") {
-        handles.extend(read_node_handles(ctx, n, &motions, mesh.len())?);
+        handles.extend(read_node_handles(ctx, n, motions, cloth.mesh.len())?);
     }
+    Ok(handles)
+}
 
-    // obstacles and contact
-    let mut obstacles = Vec::new();
-    if let Some(n) = top.get("obstacles") {
-        for (i, o) in ctx.array(n, "obstacles")?.iter().enumerate() {
-            let path = format!("obstacles[{i}]");
-            let f = ctx.fields(
-                o,
+/// `handlebars`: a handle per bar (named after its side) following its motion, and the vertices each bar holds.
+fn read_handlebars(
+    ctx: &mut Ctx,
+    n: &Node,
+    motions: &[Motion],
+    cloth: &Cloth,
+) -> Result<(Vec<HandleSpec>, Vec<Vec<usize>>), ShellError> {
+    let mut handles: Vec<HandleSpec> = Vec::new();
+    let mut held_by_bars: Vec<Vec<usize>> = Vec::new();
+    for (i, b) in ctx.array(n, "handlebars")?.iter().enumerate() {
+        let path = format!("handlebars[{i}]");
+        let (bar, motion) = read_handlebar(ctx, b, &path, motions)?;
+        let (select, held) = bar.selection(&cloth.mesh, &cloth.x0);
+        if held.is_empty() {
+            return Err(ctx.error(
+                b.line,
                 &path,
-                &[("mesh", Used), ("transform", Used), ("motion", Used)],
-            )?;
-            let mesh_node = ctx.required(&f, o.line, &path, "mesh")?;
-            let (rel, _) = ctx.resolve(mesh_node, &join(&path, "mesh"))?;
-            let transform = match f.get("transform") {
-                Some(t) => read_transform(ctx, t, &join(&path, "transform"))?,
-                None => Transform::default(),
-            };
-            let motion = match f.get("motion") {
-                Some(m) => Some(read_motion_index(ctx, m, &path, &motions)?),
-                None => None,
-            };
-            obstacles.push(ObstacleSpec::Mesh {
-                path: rel,
-                transform,
-                motion,
-            });
+                "selects no vertex of the cloth (no vertex lies strictly inside its strip)",
+            ));
         }
+        let mut name = SIDES[bar.side].to_string();
+        if handles.iter().any(|h| h.name == name) {
+            name = format!("{name}-{i}");
+        }
+        handles.push(handle(name, select, motion));
+        held_by_bars.push(held);
     }
+    Ok((handles, held_by_bars))
+}
+
+/// One handlebar at `path`: its strip (side and fractions) and its motion.
+fn read_handlebar(
+    ctx: &mut Ctx,
+    b: &Node,
+    path: &str,
+    motions: &[Motion],
+) -> Result<(Handlebar, Motion), ShellError> {
+    let f = ctx.fields(
+        b,
+        path,
+        &[
+            ("side", Used),
+            ("lengthp", Used),
+            ("widthp", Used),
+            ("insetp", Used),
+            ("motion", Used),
+        ],
+    )?;
+    let req = |k: &str| ctx.required(&f, b.line, path, k);
+    let side = ctx.index(
+        req("side")?,
+        &join(path, "side"),
+        4,
+        "0 (left), 1 (bottom), 2 (right) or 3 (top)",
+    )?;
+    let bar = Handlebar {
+        side,
+        lengthp: ctx.fraction(req("lengthp")?, &join(path, "lengthp"))?,
+        widthp: ctx.fraction(req("widthp")?, &join(path, "widthp"))?,
+        insetp: ctx.fraction(req("insetp")?, &join(path, "insetp"))?,
+    };
+    let motion = read_motion_index(ctx, req("motion")?, path, motions)?;
+    Ok((bar, motion))
+}
+
+/// `handlespheres`: the vertices within a ball, fixed or following a motion (`sphere0`, `sphere1`, …); a
+/// sphere may not hold a vertex a handlebar moves.
+fn read_handlespheres(
+    ctx: &mut Ctx,
+    n: &Node,
+    motions: &[Motion],
+    cloth: &Cloth,
+    held_by_bars: &[Vec<usize>],
+) -> Result<Vec<HandleSpec>, ShellError> {
+    let mut out = Vec::new();
+    for (i, s) in ctx.array(n, "handlespheres")?.iter().enumerate() {
+        let path = format!("handlespheres[{i}]");
+        let f = ctx.fields(
+            s,
+            &path,
+            &[("center", Used), ("radius", Used), ("motion", Used)],
+        )?;
+        let center = ctx.numbers::<3>(
+            ctx.required(&f, s.line, &path, "center")?,
+            &join(&path, "center"),
+        )?;
+        let radius = ctx.positive(
+            ctx.required(&f, s.line, &path, "radius")?,
+            &join(&path, "radius"),
+        )?;
+        let motion = match f.get("motion") {
+            Some(m) => read_motion_index(ctx, m, &path, motions)?,
+            None => Motion::fixed(),
+        };
+        let sel = Selection::Ball { center, radius };
+        let held = sel.select(&cloth.mesh, &cloth.x0);
+        if held.is_empty() {
+            return Err(ctx.error(
+                s.line,
+                &path,
+                "selects no vertex of the cloth (none within its radius of its center)",
+            ));
+        }
+        if let Some(j) = held_by_bars
+            .iter()
+            .position(|bar| bar.iter().any(|v| held.contains(v)))
+        {
+            return Err(ctx.error(
+                s.line,
+                &path,
+                format!("holds vertices that handlebars[{j}] moves too"),
+            ));
+        }
+        out.push(handle(format!("sphere{i}"), sel, motion));
+    }
+    Ok(out)
+}
+
+/// `obstacles`: a mesh each (its name relative to the scene's folder), with its transform and motion.
+fn read_obstacles(
+    ctx: &mut Ctx,
+    n: &Node,
+    motions: &[Motion],
+) -> Result<Vec<ObstacleSpec>, ShellError> {
+    let mut obstacles = Vec::new();
+    for (i, o) in ctx.array(n, "obstacles")?.iter().enumerate() {
+        let path = format!("obstacles[{i}]");
+        let f = ctx.fields(
+            o,
+            &path,
+            &[("mesh", Used), ("transform", Used), ("motion", Used)],
+        )?;
+        let mesh_node = ctx.required(&f, o.line, &path, "mesh")?;
+        let (rel, _) = ctx.resolve(mesh_node, &join(&path, "mesh"))?;
+        let transform = match f.get("transform") {
+            Some(t) => read_transform(ctx, t, &join(&path, "transform"))?,
+            None => Transform::default(),
+        };
+        let motion = match f.get("motion") {
+            Some(m) => Some(read_motion_index(ctx, m, &path, motions)?),
+            None => None,
+        };
+        obstacles.push(ObstacleSpec::Mesh {
+            path: rel,
+            transform,
+            motion,
+        });
+    }
+    Ok(obstacles)
+}
+
+/// `gravity` (default zero) and `obs_friction` (the obstacles' friction coefficient).
+fn read_gravity_friction(ctx: &mut Ctx, top: &Fields) -> Result<([f64; 3], f64), ShellError> {
     let gravity = match top.get("gravity") {
         Some(n) => ctx.numbers::<3>(n, "gravity")?,
         None => [0.0; 3],
@@ -308,10 +442,18 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
         Some(n) => ctx.non_negative(n, "obs_friction")?,
         None => DEFAULT_OBS_FRICTION,
     };
-    let contact_default = ContactSpec::default();
+    Ok((gravity, friction))
+}
+
+/// `magic`: the handle stiffness and the contact (repulsion) thickness, each with ARCSim's default.
+fn read_magic(
+    ctx: &mut Ctx,
+    node: Option<&Node>,
+    contact_default: &ContactSpec,
+) -> Result<(f64, f64), ShellError> {
     let (mut handle_stiffness, mut thickness) =
         (DEFAULT_HANDLE_STIFFNESS, DEFAULT_REPULSION_THICKNESS);
-    if let Some(n) = top.get("magic") {
+    if let Some(n) = node {
         let collision = format!(
             "the obstacle penalty here has its own stiffness (contact.stiffness = {:e} 1/(m s²), a cubic penalty per unit mass)",
             contact_default.stiffness
@@ -336,40 +478,7 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
             thickness = ctx.non_negative(t, "magic.repulsion_thickness")?;
         }
     }
-
-    Ok(Scene {
-        name: name.to_string(),
-        material,
-        mesh: MeshSpec::Obj {
-            path: mesh_rel,
-            transform,
-        },
-        placement: Placement::default(),
-        fabric_angle_deg: 0.0,
-        duration,
-        dt,
-        quasi_static: false,
-        gravity,
-        drag: 0.0,
-        damping,
-        wind,
-        handle_stiffness: Some(handle_stiffness),
-        model: ModelSpec {
-            only_1d,
-            ..ModelSpec::default()
-        },
-        psd: Psd::Psi,
-        solver: SolverSpec::default(),
-        pins: Vec::new(),
-        handles,
-        obstacles,
-        contact: ContactSpec {
-            thickness,
-            friction,
-            ..contact_default
-        },
-        output: OutputSpec { obj_every: 1 },
-    })
+    Ok((handle_stiffness, thickness))
 }
 
 /// A `transform`: `scale` (> 0), `translate` (3 numbers), `rotate` ([degrees, axis x, y, z]).

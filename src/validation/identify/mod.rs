@@ -310,11 +310,114 @@ pub fn identify(
     }];
     report(&iterations[0]);
     let mut stopped = format!("{} iterations", options.max_iterations);
+    let fit = Fit {
+        pattern,
+        start,
+        sets,
+        options,
+    };
     for it in 1..=options.max_iterations {
-        let (jtj, jtr) = normal_equations(&ev, &free);
+        let Search {
+            accepted,
+            lambda: searched,
+            rejected,
+            reasons,
+        } = fit.search(&ev, &free, q, &warm, lambda);
+        lambda = searched;
+        let Some(a) = accepted else {
+            stopped = format!(
+                "no step lowered the cost (λ = {lambda:.1e}; last: {})",
+                reasons.last().map_or("-", |s| s.as_str())
+            );
+            break;
+        };
+        let decrease = (ev.breakdown.cost - a.ev.breakdown.cost) / ev.breakdown.cost.max(1e-300);
+        q = a.q;
+        ev = a.ev;
+        warm = a.warm;
+        let row = Iteration {
+            iteration: it,
+            unknowns: q,
+            breakdown: ev.breakdown.clone(),
+            lambda,
+            rejected,
+            rejections: reasons,
+            clamped: a.clamped,
+            time: t0.elapsed().as_secs_f64(),
+        };
+        report(&row);
+        iterations.push(row);
+        lambda = (lambda / 10.0).max(1e-12);
+        if decrease < options.cost_tolerance {
+            stopped = format!("relative cost decrease {decrease:.1e} below the tolerance");
+            break;
+        }
+        if a.step < options.step_tolerance {
+            stopped = format!("largest step {:.1e} below the tolerance", a.step);
+            break;
+        }
+    }
+    let (standard_errors, correlations) = covariance(&ev, &free);
+    Ok(Identification {
+        start: base,
+        identified: material_of(&q, start),
+        unknowns: q,
+        free: options.free,
+        standard_errors,
+        correlations,
+        before,
+        after: ev.breakdown.clone(),
+        iterations,
+        stopped,
+        residual_count: ev.residual.len(),
+        time: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// What a Levenberg–Marquardt step is tried on: the pattern, the start material (the parameters that are not
+/// unknowns), the residual sets and the options.
+struct Fit<'a> {
+    pattern: &'a Pattern,
+    start: &'a YarnMaterial,
+    sets: &'a Residuals,
+    options: &'a IdentifyOptions,
+}
+
+/// A step the damped search accepted: the new unknowns, their evaluation and warm states, the unknowns clamped
+/// to the admissible box, and the largest change of an unknown.
+struct Accepted {
+    q: [f64; 5],
+    ev: Evaluation,
+    warm: WarmStates,
+    clamped: Vec<&'static str>,
+    step: f64,
+}
+
+/// The damped search of one iteration: the accepted step (if any), λ after the search, the trials rejected and
+/// why.
+struct Search {
+    accepted: Option<Accepted>,
+    lambda: f64,
+    rejected: usize,
+    reasons: Vec<String>,
+}
+
+impl Fit<'_> {
+    /// Damped Gauss–Newton steps from `q` (evaluated as `ev`), λ growing ×10 after each step that fails to lower
+    /// the cost (or whose solve fails), at most 13 trials; each step is shortened to `max_step` and clamped to the
+    /// admissible box.
+    fn search(
+        &self,
+        ev: &Evaluation,
+        free: &[usize],
+        q: [f64; 5],
+        warm: &WarmStates,
+        mut lambda: f64,
+    ) -> Search {
+        let options = self.options;
+        let (jtj, jtr) = normal_equations(ev, free);
         let mut rejected = 0;
         let mut reasons = Vec::new();
-        let mut accepted = None;
         while rejected <= 12 {
             let mut a = jtj.clone();
             for i in 0..free.len() {
@@ -337,12 +440,29 @@ pub fn identify(
             }
             let clamped = clamp(&mut trial);
             let mut trial_warm = warm.clone();
-            let m = material_of(&trial, start);
-            match evaluate(pattern, &m, sets, &options.solver, &mut trial_warm) {
+            let m = material_of(&trial, self.start);
+            match evaluate(
+                self.pattern,
+                &m,
+                self.sets,
+                &options.solver,
+                &mut trial_warm,
+            ) {
                 Ok(e) if e.breakdown.cost < ev.breakdown.cost => {
                     let step = (0..5).map(|k| (trial[k] - q[k]).abs()).fold(0.0, f64::max);
-                    accepted = Some((trial, e, trial_warm, clamped, step));
-                    break;
+                    let accepted = Accepted {
+                        q: trial,
+                        ev: e,
+                        warm: trial_warm,
+                        clamped,
+                        step,
+                    };
+                    return Search {
+                        accepted: Some(accepted),
+                        lambda,
+                        rejected,
+                        reasons,
+                    };
                 }
                 // a higher cost or a solve that did not converge: a shorter step
                 other => {
@@ -355,54 +475,13 @@ pub fn identify(
                 }
             }
         }
-        let Some((trial, e, trial_warm, clamped, step)) = accepted else {
-            stopped = format!(
-                "no step lowered the cost (λ = {lambda:.1e}; last: {})",
-                reasons.last().map_or("-", |s| s.as_str())
-            );
-            break;
-        };
-        let decrease = (ev.breakdown.cost - e.breakdown.cost) / ev.breakdown.cost.max(1e-300);
-        q = trial;
-        ev = e;
-        warm = trial_warm;
-        let row = Iteration {
-            iteration: it,
-            unknowns: q,
-            breakdown: ev.breakdown.clone(),
+        Search {
+            accepted: None,
             lambda,
             rejected,
-            rejections: reasons,
-            clamped,
-            time: t0.elapsed().as_secs_f64(),
-        };
-        report(&row);
-        iterations.push(row);
-        lambda = (lambda / 10.0).max(1e-12);
-        if decrease < options.cost_tolerance {
-            stopped = format!("relative cost decrease {decrease:.1e} below the tolerance");
-            break;
-        }
-        if step < options.step_tolerance {
-            stopped = format!("largest step {step:.1e} below the tolerance");
-            break;
+            reasons,
         }
     }
-    let (standard_errors, correlations) = covariance(&ev, &free);
-    Ok(Identification {
-        start: base,
-        identified: material_of(&q, start),
-        unknowns: q,
-        free: options.free,
-        standard_errors,
-        correlations,
-        before,
-        after: ev.breakdown.clone(),
-        iterations,
-        stopped,
-        residual_count: ev.residual.len(),
-        time: t0.elapsed().as_secs_f64(),
-    })
 }
 
 /// JᵀJ and Jᵀr over the free columns.

@@ -1,7 +1,10 @@
 //! PNG plots of `hylc identify` (issue 22, item 3): line plots of several series (our 1D curves against the
 //! original's, the displacement error per grid axis value before and after), drawn with plotters' bitmap backend.
+//! [`write_plots`] and [`plot_study`] write the files of an identification.
 
-use super::IdentifyError;
+use super::held_out::{HeldOut, StudyCurve, STUDY_PARAMETERS};
+use super::{Identification, IdentifyError};
+use crate::validation::grid::AXIS_LEN;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -111,4 +114,206 @@ fn draw(
     }
     root.present()?;
     Ok(())
+}
+
+/// The names of the grid's three axes (the in-plane strains).
+const AXIS_NAMES: [&str; 3] = ["s_x", "s_a", "s_y"];
+
+/// The plots of an identification in `out` (titles start with `stem`): the RMS position error of the fitted grid
+/// points by axis value before and after (`fit_grid_error.png`, when residual b was on), and with the held-out
+/// numbers before and after ([start, identified]) the full grid's error by axis (`grid_error_by_axis.png`) and
+/// the 1D curves (`curves.png`).
+pub fn write_plots(
+    out: &Path,
+    stem: &str,
+    r: &Identification,
+    validation: Option<&[HeldOut]>,
+) -> Result<(), IdentifyError> {
+    if !r.before.grid_points.is_empty() {
+        plot_fit_grid_error(out, stem, r)?;
+    }
+    if let Some([before, after]) = validation {
+        if let (Some(bx), Some(ax), Some(axes)) =
+            (before.grid_rms_by_axis, after.grid_rms_by_axis, after.axes)
+        {
+            plot_grid_error_by_axis(out, stem, &bx, &ax, &axes)?;
+        }
+        plot_curves(out, stem, before, after)?;
+    }
+    Ok(())
+}
+
+/// RMS per axis value of the fitted grid points: (axis value, RMS) per axis.
+fn by_axis(points: &[([f64; 3], f64)]) -> [Vec<(f64, f64)>; 3] {
+    std::array::from_fn(|k| {
+        let mut vals: Vec<f64> = points.iter().map(|p| p.0[k]).collect();
+        vals.sort_by(f64::total_cmp);
+        vals.dedup();
+        vals.iter()
+            .map(|&v| {
+                let sel: Vec<f64> = points
+                    .iter()
+                    .filter(|p| p.0[k] == v)
+                    .map(|p| p.1 * p.1)
+                    .collect();
+                (v, (sel.iter().sum::<f64>() / sel.len() as f64).sqrt())
+            })
+            .collect()
+    })
+}
+
+/// Two series, "before" and "after", in the colours 1 and 2.
+fn before_after(before: Vec<(f64, f64)>, after: Vec<(f64, f64)>, markers: bool) -> Vec<Series> {
+    vec![
+        Series {
+            label: "before".into(),
+            points: before,
+            colour: 1,
+            markers,
+        },
+        Series {
+            label: "after".into(),
+            points: after,
+            colour: 2,
+            markers,
+        },
+    ]
+}
+
+/// fit_grid_error.png: the fitted grid points' RMS error by the value of each axis, before and after.
+fn plot_fit_grid_error(out: &Path, stem: &str, r: &Identification) -> Result<(), IdentifyError> {
+    let (b, a) = (
+        by_axis(&r.before.grid_points),
+        by_axis(&r.after.grid_points),
+    );
+    let panels: Vec<(String, String, Vec<Series>)> = (0..3)
+        .map(|k| {
+            (
+                format!("error by {} (fitted points)", AXIS_NAMES[k]),
+                AXIS_NAMES[k].to_string(),
+                before_after(b[k].clone(), a[k].clone(), true),
+            )
+        })
+        .collect();
+    plot_panels(
+        &out.join("fit_grid_error.png"),
+        &format!("{stem}: RMS position error [r]"),
+        "RMS error [r]",
+        &panels,
+    )
+}
+
+/// grid_error_by_axis.png: the full grid's RMS error by the value of each axis (`axes`), before and after.
+fn plot_grid_error_by_axis(
+    out: &Path,
+    stem: &str,
+    bx: &[[f64; AXIS_LEN]; 3],
+    ax: &[[f64; AXIS_LEN]; 3],
+    axes: &[[f64; AXIS_LEN]; 3],
+) -> Result<(), IdentifyError> {
+    let line = |v: &[f64; AXIS_LEN], k: usize| -> Vec<(f64, f64)> {
+        (0..AXIS_LEN).map(|i| (axes[k][i], v[i])).collect()
+    };
+    let panels: Vec<(String, String, Vec<Series>)> = (0..3)
+        .map(|k| {
+            (
+                format!("full grid, by {}", AXIS_NAMES[k]),
+                AXIS_NAMES[k].to_string(),
+                before_after(line(&bx[k], k), line(&ax[k], k), false),
+            )
+        })
+        .collect();
+    plot_panels(
+        &out.join("grid_error_by_axis.png"),
+        &format!("{stem}: full-grid RMS position error [r]"),
+        "RMS error [r]",
+        &panels,
+    )
+}
+
+/// curves.png: each 1D curve of the original material against ours at the start and identified parameters
+/// (nothing when there are no curves).
+fn plot_curves(
+    out: &Path,
+    stem: &str,
+    before: &HeldOut,
+    after: &HeldOut,
+) -> Result<(), IdentifyError> {
+    let panels: Vec<(String, String, Vec<Series>)> = after
+        .curves
+        .iter()
+        .zip(&before.curves)
+        .map(|(a, b)| {
+            let pts =
+                |c: &[f64], s: &[f64]| s.iter().copied().zip(c.iter().copied()).collect::<Vec<_>>();
+            (
+                format!("f0 + f_{}: after {:.1} %", a.component, 100.0 * a.rel_rms),
+                a.component.to_string(),
+                vec![
+                    Series {
+                        label: "original".into(),
+                        points: pts(&a.original, &a.strains),
+                        colour: 0,
+                        markers: false,
+                    },
+                    Series {
+                        label: "ours, start".into(),
+                        points: pts(&b.ours, &b.strains),
+                        colour: 1,
+                        markers: true,
+                    },
+                    Series {
+                        label: "ours, identified".into(),
+                        points: pts(&a.ours, &a.strains),
+                        colour: 2,
+                        markers: true,
+                    },
+                ],
+            )
+        })
+        .collect();
+    if panels.is_empty() {
+        return Ok(());
+    }
+    plot_panels(
+        &out.join("curves.png"),
+        &format!("{stem}: 1D curves [J/m2]"),
+        "energy density [J/m2]",
+        &panels,
+    )
+}
+
+/// study.png: θ ∂Ψ̄/∂θ along each 1D range, one panel per range, one series per parameter.
+pub fn plot_study(out: &Path, stem: &str, curves: &[StudyCurve]) -> Result<(), IdentifyError> {
+    let panels: Vec<(String, String, Vec<Series>)> = curves
+        .iter()
+        .map(|c| {
+            let series = (0..5)
+                .map(|j| Series {
+                    label: format!("d psi / d ln {}", STUDY_PARAMETERS[j]),
+                    points: c
+                        .strains
+                        .iter()
+                        .copied()
+                        .zip(c.dpsi_dlog[j].iter().copied())
+                        .collect(),
+                    colour: j + 1,
+                    markers: false,
+                })
+                .collect();
+            (
+                format!("f0 + f_{}", c.component),
+                c.component.to_string(),
+                series,
+            )
+        })
+        .collect();
+    plot_panels(
+        &out.join("study.png"),
+        &format!(
+            "{stem}: sensitivity of the energy density to the yarn parameters [J/m2 per ln θ]"
+        ),
+        "J/m2",
+        &panels,
+    )
 }
