@@ -212,3 +212,28 @@ fn run_and_scene_plan_reject_bad_input_with_one_line() {
     ]);
     assert!(e.contains("/nonexistent/log.jsonl: cannot read"), "{e}");
 }
+
+/// A misspelt plan, scene or pattern stops `hylc run` before anything is computed or written (exit 2, the valid
+/// names in the message; before these checks a misspelt scene failed after 50 s of sampling).
+#[test]
+fn run_checks_its_inputs_before_computing() {
+    let out = std::env::temp_dir().join(format!("hylc-run-check-{}", std::process::id()));
+    for (flag, value, want) in [
+        (
+            "--plan",
+            "fast",
+            "fast: not a plan (default, reduced, quick, holdout)",
+        ),
+        (
+            "--scene",
+            "drap-x",
+            "drap-x: no such scene file and not a built-in scene (stretch-x,",
+        ),
+        ("--pattern", "stockinete", "stockinete"),
+    ] {
+        let e = common::cli_error(&["run", flag, value, "--out", out.to_str().unwrap()]);
+        assert!(e.contains(want), "{flag} {value}: {e}");
+        // nothing written: the output folder is made before the first stage
+        assert!(!out.exists(), "{flag} {value}: wrote {}", out.display());
+    }
+}

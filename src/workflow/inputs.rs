@@ -98,13 +98,21 @@ pub fn reference_of(
     Ok((q, report, construction))
 }
 
-/// A plan by name (`default`, `reduced`, `quick`, `holdout`) or JSON file.
+/// The names of the built-in sampling plans.
+pub const PLAN_NAMES: [&str; 4] = ["default", "reduced", "quick", "holdout"];
+
+/// A plan by name (`default`, `reduced`, `quick`, `holdout`) or JSON file; an argument that is neither names the
+/// plans there are.
 pub fn load_plan(arg: &str) -> Result<Plan, WorkflowError> {
     match arg {
         "default" => Ok(Plan::default()),
         "reduced" => Ok(Plan::reduced()),
         "quick" => Ok(Plan::quick()),
         "holdout" => Ok(Plan::holdout()),
+        _ if !Path::new(arg).exists() => Err(WorkflowError::Input(format!(
+            "{arg}: not a plan ({}) and no such plan file",
+            PLAN_NAMES.join(", ")
+        ))),
         _ => Ok(Plan::load(Path::new(arg))?),
     }
 }

@@ -137,6 +137,7 @@ pub fn run(
     on_event: &mut (dyn FnMut(Event) + Send),
 ) -> Result<serde_json::Value, WorkflowError> {
     let t0 = Instant::now();
+    check_inputs(args)?;
     if args.fresh && args.out.exists() {
         std::fs::remove_dir_all(&args.out)
             .map_err(|e| WorkflowError::io(&args.out, "cannot remove", e))?;
@@ -221,6 +222,18 @@ pub fn run(
         serde_json::to_string_pretty(&summary).expect("JSON values serialise") + "\n",
     )?;
     Ok(summary)
+}
+
+/// Every input of a run checked before anything is computed or written: each pattern (a file or a generated
+/// kind, with its construction), the plan (a name or a file) and the scene (a built-in or a file).
+fn check_inputs(args: &RunConfig) -> Result<(), WorkflowError> {
+    for p in &args.patterns {
+        load_pattern(p)?;
+        construction_of(p, args.construction)?;
+    }
+    load_plan(&args.plan)?;
+    crate::shell::arcsim::load_scene(&args.scene)?;
+    Ok(())
 }
 
 /// The name of a pattern argument as a folder name (`stockinette`, `my.pyp` → `my`).
