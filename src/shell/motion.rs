@@ -221,7 +221,7 @@ impl Motion {
     /// The interval [tᵢ, tᵢ₊₁) holding t, or `None` before the first and from the last keyframe on.
     fn interval(&self, t: f64) -> Option<usize> {
         let k = &self.keyframes;
-        if k.len() < 2 || !(t >= k[0].time) || t >= k[k.len() - 1].time {
+        if k.len() < 2 || t.is_nan() || t < k[0].time || t >= k[k.len() - 1].time {
             return None;
         }
         // the number of keyframes at or before t, less one
@@ -231,7 +231,7 @@ impl Motion {
     /// The translation outside the keyframes' span (module documentation).
     fn held(&self, t: f64) -> [f64; 3] {
         match (self.keyframes.first(), self.keyframes.last()) {
-            (Some(first), _) if !(t > first.time) => first.offset,
+            (Some(first), _) if t.is_nan() || t <= first.time => first.offset,
             (_, Some(last)) => last.offset,
             _ => [0.0; 3],
         }
