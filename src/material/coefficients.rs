@@ -66,7 +66,9 @@ impl MaterialGradient {
     pub fn get(&self, c: Coefficient) -> f64 {
         match c {
             Coefficient::Constant => self.constant,
-            Coefficient::Term1D { term, slope, index } => self.terms1d[term][usize::from(slope)][index],
+            Coefficient::Term1D { term, slope, index } => {
+                self.terms1d[term][usize::from(slope)][index]
+            }
             Coefficient::Term2D { term, array, index } => self.terms2d[term][array][index],
         }
     }
@@ -111,7 +113,11 @@ impl Material {
         let mut out = vec![Coefficient::Constant];
         for (term, t) in self.terms1d.iter().enumerate() {
             for slope in [false, true] {
-                out.extend((0..t.spline.t.len()).map(|index| Coefficient::Term1D { term, slope, index }));
+                out.extend((0..t.spline.t.len()).map(|index| Coefficient::Term1D {
+                    term,
+                    slope,
+                    index,
+                }));
             }
         }
         for (term, t) in self.terms2d.iter().enumerate() {
@@ -183,7 +189,14 @@ impl Material {
                 let [p, mu, mv, muv] = arrs;
                 m.terms2d.push(Term2D {
                     strains: t.strains,
-                    spline: Hermite2D::new(t.spline.tu.clone(), t.spline.tv.clone(), p, mu, mv, muv),
+                    spline: Hermite2D::new(
+                        t.spline.tu.clone(),
+                        t.spline.tv.clone(),
+                        p,
+                        mu,
+                        mv,
+                        muv,
+                    ),
                 });
             }
         }
@@ -213,7 +226,10 @@ impl Material {
         for (term, t) in self.terms1d.iter().enumerate() {
             let r = self.knot_support(&t.spline.t, t.strain.index(), z);
             for slope in [false, true] {
-                out.extend(r.clone().map(|index| Coefficient::Term1D { term, slope, index }));
+                out.extend(
+                    r.clone()
+                        .map(|index| Coefficient::Term1D { term, slope, index }),
+                );
             }
         }
         for (term, t) in self.terms2d.iter().enumerate() {
