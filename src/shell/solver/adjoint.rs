@@ -439,10 +439,5 @@ mod tests {
         for (a, b) in g.iter().zip(&ex.g_full) {
             assert!((a - b).abs() <= 1e-12 * gs.max(1.0), "{a} vs {b}");
         }
-        let nf = 3 * sim.pattern.nfree;
-        println!(
-            "exact factorises: {}",
-            sim.factor_solve(&ex.values, &vec![1.0; nf]).is_some()
-        );
     }
 }
