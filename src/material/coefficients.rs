@@ -159,7 +159,7 @@ impl Material {
     }
 
     /// The material whose only non-zero coefficient is `c` = 1, with only `c`'s term: its ψ is φ_c.
-    fn unit(&self, c: Coefficient) -> Material {
+    pub fn unit_material(&self, c: Coefficient) -> Material {
         let mut m = Material {
             density: self.density,
             strain_scale: self.strain_scale,
@@ -271,7 +271,10 @@ impl<'a> BasisEvaluator<'a> {
             return (1.0, [0.0; 6]);
         }
         let material = self.material;
-        let unit = self.cache.entry(c).or_insert_with(|| material.unit(c));
+        let unit = self
+            .cache
+            .entry(c)
+            .or_insert_with(|| material.unit_material(c));
         let p = unit.eval(z);
         (p.value, p.grad)
     }
@@ -279,14 +282,20 @@ impl<'a> BasisEvaluator<'a> {
     /// φ_c, ∇φ_c and ∇²φ_c at z.
     pub fn basis_hessian(&mut self, c: Coefficient, z: &[f64; 6]) -> super::PsiVgh {
         let material = self.material;
-        let unit = self.cache.entry(c).or_insert_with(|| material.unit(c));
+        let unit = self
+            .cache
+            .entry(c)
+            .or_insert_with(|| material.unit_material(c));
         unit.eval(z)
     }
 
     /// The generic reference twin of φ_c (for AD checks).
     pub fn reference<D: crate::real::Real>(&mut self, c: Coefficient, z: &[D]) -> D {
         let material = self.material;
-        let unit = self.cache.entry(c).or_insert_with(|| material.unit(c));
+        let unit = self
+            .cache
+            .entry(c)
+            .or_insert_with(|| material.unit_material(c));
         unit.reference(z)
     }
 }
@@ -392,7 +401,7 @@ mod tests {
         let mut checked = 0;
         for &c in sup.iter().step_by(5) {
             let (_, g) = ev.basis(c, &z);
-            let unit = m.unit(c);
+            let unit = m.unit_material(c);
             let (_, gad, _) = num_dual::hessian(
                 |x: DVector<Dual2DVec64>| {
                     let v: Vec<Dual2DVec64> = x.iter().cloned().collect();
