@@ -298,6 +298,40 @@ pub fn diff_checks() -> Vec<Box<dyn Check>> {
             material: PsiCheck::only(&m, one, two),
         }));
     }
+    // basis functions φ_j = ∂ψ/∂c_j of single coefficients (`material::coefficients`): their unit materials
+    use crate::material::coefficients::Coefficient;
+    let basis = [
+        (
+            "basis phi[f0 p5]",
+            Coefficient::Term1D {
+                term: 0,
+                slope: false,
+                index: 5,
+            },
+        ),
+        (
+            "basis phi[f3 p5]",
+            Coefficient::Term1D {
+                term: 3,
+                slope: false,
+                index: 5,
+            },
+        ),
+        (
+            "basis phi[f03 p36]",
+            Coefficient::Term2D {
+                term: 2,
+                array: 0,
+                index: 36,
+            },
+        ),
+    ];
+    for (name, c) in basis {
+        v.push(Box::new(PsiCheck {
+            name: name.into(),
+            material: m.unit_material(c),
+        }));
+    }
     v.push(Box::new(PsiCheck {
         name: "psi[default]".into(),
         material: m,

@@ -9,6 +9,7 @@
 //! with the matrix functions in divided-difference form ([`spectral`]). [`Material::eval`] is the fast path
 //! (value, gradient, Hessian), [`Material::reference`] its generic twin for the derivative harness.
 
+pub mod coefficients;
 pub mod hermite;
 pub mod json;
 pub mod spectral;

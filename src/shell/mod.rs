@@ -206,6 +206,19 @@ pub enum ShellError {
     /// The Newton matrix of a step could not be factorised at any diagonal shift.
     #[error("step {step}: the Newton system could not be factorised even with a diagonal shift")]
     Factorization { step: usize },
+    /// The exact Hessian at an equilibrium is not positive definite: it is not a strict minimum and its
+    /// sensitivities are undefined (`solver::adjoint`).
+    #[error(
+        "the exact Hessian at the state (largest residual force {residual:e} N) is not positive definite: \
+         not a strict minimum, so its sensitivities are undefined"
+    )]
+    NotStrictMinimum { residual: f64 },
+    /// Sensitivities asked for where the adjoint does not apply.
+    #[error("sensitivities unavailable: {reason}")]
+    AdjointUnsupported { reason: &'static str },
+    /// A reaction asked for a held set that does not exist.
+    #[error("no held set named {set:?} (the handles' names, or `pinned`)")]
+    UnknownHeldSet { set: String },
 }
 
 impl ShellError {

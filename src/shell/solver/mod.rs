@@ -58,10 +58,12 @@
 //! of p − oᵢ found in the shape's own placement, then translated), and lagged friction charges the tangential
 //! displacement relative to the obstacle, δ = x − xₙ − (oᵢ(t₁) − oᵢ(tₙ)).
 
+mod adjoint;
 mod integrator;
 mod linear;
 mod terms;
 
+pub use adjoint::{Observable, Sensitivity};
 pub use integrator::{bdf2_coefficients, Integrator};
 use integrator::{Anchor, History};
 
