@@ -105,7 +105,7 @@ impl Differentiable for PairCheck {
 /// The pair energy as a function of the 12 coordinates and the contact radius r (13 inputs): the fast side is
 /// the kernel's value, gradient and Hessian with the radius derivatives of
 /// [`PairKernel::radius_derivatives`] as the 13th gradient entry and the last Hessian row and column (the mixed
-/// derivative ∂(∇ₓE)/∂r of the equilibrium sensitivities, issue 22); the reference is the plain formula with r
+/// derivative ∂(∇ₓE)/∂r of the equilibrium sensitivities, docs/yarn-parameters.md); the reference is the plain formula with r
 /// as a dual number. Scales as [`PairCheck`] (r is a length like the coordinates, so ∂E/∂r ~ V/r and the mixed
 /// and second radius derivatives ~ V/r²); samples are [`sample_pair`]'s at r = 1 mm, the radius input at r.
 pub struct PairRadiusCheck {

@@ -224,7 +224,7 @@ pub(crate) fn reference_energy<D: Real>(
 pub fn diff_checks() -> Vec<Box<dyn Check>> {
     let m = YarnMaterial::default();
     let patterns = crate::generate::harness_patterns();
-    // the bending-discretisation variant (issue 22) on the first pattern: the rest-curvature conversion and
+    // the bending-discretisation variant (docs/yarn-parameters.md) on the first pattern: the rest-curvature conversion and
     // the form's kernels assembled into a tile
     let sin = YarnMaterial {
         bending: crate::rod::BendingForm::Sin,

@@ -1,4 +1,4 @@
-//! Yarn crossings along a motion: continuous collision detection of yarn centre lines (issue 19, item 1, the
+//! Yarn crossings along a motion: continuous collision detection of yarn centre lines (docs/sampling.md, the
 //! guard of a "defined Ψ̄").
 //!
 //! Two yarns that pass through each other change the tile's topology (e.g. a knit loop pulled through its

@@ -213,7 +213,7 @@ impl PairKernel {
         Ok(self.stiffness * rest_a * rest_b * acc)
     }
 
-    /// The radius derivatives of E_ab at fixed points (issue 22: equilibrium sensitivities to the contact radius):
+    /// The radius derivatives of E_ab at fixed points (docs/yarn-parameters.md: equilibrium sensitivities to the contact radius):
     /// ∂E/∂r, the mixed derivative ∂(∇ₓE)/∂r (12 entries, points in the order of `x`) and ∂²E/∂r².
     ///
     /// Per term, with u = d²/(4r²), g(u) = (1 − u)²/u and the gradient β d, β = W g'(u)/(2r²) (module docs):

@@ -658,7 +658,7 @@ fn meta_block(
             "strict_patches": opts.strict_patches,
         }),
     );
-    // the options of issue 19 appear only when set, so a default fit's meta block stays as it was
+    // the optional fit settings appear only when set, so a default fit's meta block stays as it was
     if let Some(serde_json::Value::Object(o)) = meta.get_mut("fit options") {
         if opts.compression_residual {
             o.insert("compression_residual".into(), serde_json::json!(true));

@@ -38,7 +38,7 @@ pub struct SolverOptions {
     /// How a Newton step treats an indefinite Hessian ([`StepRule`]): inertia-controlled steps (the default) or
     /// the design's shift rule alone (reproduces the solver and the sample files from before 5 December 2026).
     pub step_rule: StepRule,
-    /// Yarn crossings along the Newton path ([`crate::contact::ccd`]; issue 19, item 1): not checked (the
+    /// Yarn crossings along the Newton path ([`crate::contact::ccd`]; docs/sampling.md): not checked (the
     /// default), counted (each accepted step is tested; [`crate::micro::Solution::crossings`]), or rejected (a
     /// line-search trial whose step passes two yarn centre lines through each other is not accepted, so the solve
     /// stays in the fabric it started in). A sample chain ([`crate::sample`]) applies the same to the way from a
@@ -78,7 +78,7 @@ pub enum StepRule {
     /// back from sliding) and the energy then falls by at least a quarter of the decrease the quadratic model
     /// predicts; otherwise the step is the design's: μ grown ×10 until the (inertia-tested) shifted step exists,
     /// with backtracking. A backtracked step whose predicted decrease is at round-off level
-    /// (≤ 1e-11 (|E| + k_s r)) ends the solve as converged. Measured in the guide, "Micro-solver speed (issue 20)".
+    /// (≤ 1e-11 (|E| + k_s r)) ends the solve as converged. Measured in docs/notes/micro-solver-speed.md.
     #[default]
     Inertia,
     /// The design's rule alone: μ grown ×10 until H + μI is positive definite in the full space, with

@@ -1,4 +1,4 @@
-//! The motion before a warm-started solve's first Newton step, and the yarn crossings along it (issue 19, item 1:
+//! The motion before a warm-started solve's first Newton step, and the yarn crossings along it (docs/sampling.md:
 //! a defined Ψ̄ needs every start to stay in its fabric).
 //!
 //! A chain hands a solve the equilibrium of a neighbouring strain. Before Newton starts, that state moves twice:

@@ -1,4 +1,4 @@
-//! Predictors for continuation along a chain of strains (issue 20, item 1): the start state of a solve at a
+//! Predictors for continuation along a chain of strains (docs/micro-solver.md): the start state of a solve at a
 //! strain next to one or two equilibria already found.
 //!
 //! - Secant ([`MicroProblem::predict`]): from two equilibria, y extrapolated linearly along the chain; it returns

@@ -21,8 +21,8 @@ pub enum BendingForm {
     /// k(φ) = 2 tan(φ/2) (Bergou et al.): κb = 2 e⁰ × e¹ / (|e⁰||e¹| + e⁰·e¹); the design's form.
     #[default]
     Tan,
-    /// k(φ) = 2 sin(φ/2): κb = 2 e⁰ × e¹ / √(2 |e⁰||e¹| (|e⁰||e¹| + e⁰·e¹)), bounded as φ → π (issue 22's
-    /// bending-discretisation variant).
+    /// k(φ) = 2 sin(φ/2): κb = 2 e⁰ × e¹ / √(2 |e⁰||e¹| (|e⁰||e¹| + e⁰·e¹)), bounded as φ → π (the bending-discretisation
+    /// variant, docs/yarn-parameters.md).
     Sin,
 }
 

@@ -1,6 +1,6 @@
 //! Yarn material parameters (`../shared/design/02-yarn-model.md`, "Discrete elastic rods" and "Yarn-yarn
-//! contact"): one struct that every yarn energy takes by reference, read from and written to JSON (issue 22,
-//! item 1: yarn parameters as data).
+//! contact"): one struct that every yarn energy takes by reference, read from and written to JSON (docs/yarn-parameters.md,
+//! "Yarn parameters as data").
 //!
 //! The JSON form is one object with every field of [`YarnMaterial`] as a key, all required (a file names every
 //! parameter it was made with, so a later change of the defaults cannot silently change what it means), unknown

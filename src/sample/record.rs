@@ -35,7 +35,7 @@ pub struct Record {
     pub start: SampleStart,
     /// Hash of (pattern, yarn parameters, solver settings), 16 hex digits ([`problem_hash`](super::run::problem_hash)).
     pub problem: String,
-    /// Every start of a multi-start sample ([`RunOptions::starts`](super::RunOptions::starts); issue 19, item 1); empty (omitted) when the
+    /// Every start of a multi-start sample ([`RunOptions::starts`](super::RunOptions::starts); docs/sampling.md); empty (omitted) when the
     /// sample was solved from one start.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub starts: Vec<StartResult>,

@@ -7,7 +7,7 @@
 //!   chain), extrapolated with the secant predictor [`MicroProblem::predict`] when that step's own predecessor
 //!   converged too ([`RunOptions::predictor`]); `cold` starts every sample from the reference state. A record's
 //!   `time` includes the predictor's.
-//! - Multi-start ([`RunOptions::starts`], [`super::starts`]; issue 19, item 1): `warm+cold` also solves every
+//! - Multi-start ([`RunOptions::starts`], [`super::starts`]; docs/sampling.md): `warm+cold` also solves every
 //!   sample from the reference state and writes the lowest converged Ψ̄, listing every start.
 //! - The sample file is JSON lines, append-only: one [`Record`] per sample, written as one `write` call of the
 //!   full line and then synced to disk, so an interrupted run loses at most the sample in flight.
@@ -45,7 +45,7 @@ pub struct RunOptions {
     pub limit: Option<usize>,
     /// The predictor of warm starts.
     pub predictor: Predictor,
-    /// The starts of every sample (issue 19, item 1; [`super::starts`]); not with `cold`.
+    /// The starts of every sample (docs/sampling.md; [`super::starts`]); not with `cold`.
     pub starts: Starts,
     /// `Starts::All`: the relative difference of the warm and the cold Ψ̄ above which the reversed chain is tried
     /// too ([`super::starts::DEFAULT_DISAGREEMENT`] when `None`).

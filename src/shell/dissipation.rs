@@ -1,4 +1,4 @@
-//! Dissipation in the incremental potential (issue 18; ARCSim-HYLC's damping and air drag): forces that depend
+//! Dissipation in the incremental potential (docs/cloth-simulator.md; ARCSim-HYLC's damping and air drag): forces that depend
 //! on the velocity v = (x − xₙ)/h of the step enter Φ as potentials whose gradient is minus the force, with the
 //! geometry lagged at xₙ so that every term has an exact Jacobian.
 //!

@@ -1,4 +1,4 @@
-//! The fold barrier (our addition to the HYLC shell model; issue 18): a hinge may not fold flat onto itself.
+//! The fold barrier (our addition to the HYLC shell model; docs/cloth-simulator.md): a hinge may not fold flat onto itself.
 //!
 //! The strain chain measures a hinge's dihedral angle θ ∈ (−π, π] with atan2 (`05-macro.md`, "Strain chain"), so
 //! when two neighbouring triangles fold through each other (|θ| → π, possible because the cloth has no

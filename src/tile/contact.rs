@@ -219,7 +219,7 @@ impl Tile<'_> {
     /// ∂E_contact/∂ρ and ∂(∇_y E_contact)/∂ρ (tile dofs) at dofs `y`, with ρ the contact radius
     /// ([`Tile::contact_radius`]) and k_c the material's: the pair kernels' radius derivatives
     /// ([`PairKernel::radius_derivatives`]) summed over the contact pairs, the position blocks turned into the dof
-    /// frame as the gradient's are (issue 22: equilibrium sensitivities to the contact radius).
+    /// frame as the gradient's are (docs/yarn-parameters.md: equilibrium sensitivities to the contact radius).
     pub fn contact_radius_derivatives(
         &self,
         y: &[f64],

@@ -5,8 +5,8 @@
 //! - [`calibration`]: the yarn parameters that make the original reference patterns static equilibria (item 3b);
 //! - [`grid`]: our micro solver against the original solver's displacements on the 9×9×9 grid (item 3c);
 //! - [`identify`]: the yarn parameters from the original data by Levenberg–Marquardt with the solver's derivatives
-//!   (issue 22);
-//! - [`fuzz`]: mutated inputs of the five input formats through the parsers and evaluators (issue 17).
+//!   (docs/yarn-parameters.md);
+//! - [`fuzz`]: mutated inputs of the five input formats through the parsers and evaluators (docs/robustness.md).
 //!
 //! Each reads `../shared` (the caller passes the folder or files) and returns numbers; the callers (`hylc
 //! validate`, `hylc calibrate`, `hylc micro-grid`, the conformance tests) decide what passes.

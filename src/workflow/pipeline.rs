@@ -443,7 +443,7 @@ fn stage_sample(args: &RunConfig, dir: &Path, log: &mut Log) -> Result<Sampled, 
     let t = Instant::now();
     let ref_path = dir.join("reference.pyp");
     let (q, _) = Pattern::load_pyp(&ref_path)?;
-    // the crossing guard: no sample (and no chain start) of another fabric (issue 19, item 1)
+    // the crossing guard: no sample (and no chain start) of another fabric (docs/sampling.md)
     let options = SolverOptions {
         crossings: CrossingGuard::Reject,
         ..Default::default()

@@ -29,13 +29,13 @@ pub struct Overrides {
 }
 
 /// The scene `scene_arg` (a JSON file or a built-in) after the overrides, with the folder its relative paths
-/// start from. An ARCSim scene file is converted (issue 18; [`crate::shell::arcsim`]); its conversion warnings are
+/// start from. An ARCSim scene file is converted (docs/arcsim.md; [`crate::shell::arcsim`]); its conversion warnings are
 /// dropped here ([`prepare_noted`] reports them).
 pub fn prepare(scene_arg: &str, ov: &Overrides) -> Result<(Scene, PathBuf), WorkflowError> {
     prepare_noted(scene_arg, ov, &mut |_| {})
 }
 
-/// [`prepare`], reporting the warnings of an ARCSim scene's conversion (issue 18: one line per ignored or unknown
+/// [`prepare`], reporting the warnings of an ARCSim scene's conversion (docs/arcsim.md: one line per ignored or unknown
 /// key) as [`Event::Note`]s.
 pub fn prepare_noted(
     scene_arg: &str,

@@ -1,5 +1,5 @@
 //! `hylc compare-samples A.jsonl B.jsonl [--rel 1e-6]`: the agreement of two sample files of one plan, e.g.
-//! warm-first against cold-first (issue 19, item 1; `hylc::sample::compare`).
+//! warm-first against cold-first (docs/sampling.md; `hylc::sample::compare`).
 
 use anyhow::bail;
 use hylc::sample::{compare, read_samples};

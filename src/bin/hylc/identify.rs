@@ -1,5 +1,5 @@
 //! `hylc identify PATTERN.pyp`: the yarn parameters from the original's data by Levenberg–Marquardt with the
-//! solver's own derivatives (issue 22, items 3–5; `hylc::validation::identify`).
+//! solver's own derivatives (docs/yarn-parameters.md; `hylc::validation::identify`).
 
 use crate::args::{parse_list, SolverArgs, YarnArgs};
 use crate::strain::load_pattern_noted;

@@ -38,7 +38,7 @@ pub struct Args {
     /// equilibrium itself)
     #[arg(long, value_enum, default_value_t = PredictorArg::Secant)]
     predictor: PredictorArg,
-    /// starts of every sample (issue 19, item 1): warm (along the chain), or warm+cold (also from the reference
+    /// starts of every sample: warm (along the chain), or warm+cold (also from the reference
     /// state, keeping the lowest converged Ψ̄; the record lists every start), or all (where warm and cold
     /// disagree, also from the steps that continue the sample: the chain in reverse)
     #[arg(long, value_enum, default_value_t = StartsArg::Warm)]
@@ -84,7 +84,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let mut options = a.solver.options();
     let starts = Starts::from(a.starts);
     if starts != Starts::Warm && a.solver.crossings.is_none() {
-        // a start that pulls yarns through each other ends in another fabric (issue 19, item 1)
+        // a start that pulls yarns through each other ends in another fabric (docs/sampling.md)
         options.crossings = CrossingGuard::Reject;
     }
     let problem = MicroProblem::new(p, &yarn, options);

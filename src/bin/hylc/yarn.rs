@@ -1,4 +1,4 @@
-//! `hylc yarn [FILE]`: the yarn parameters as JSON (`hylc::rod::YarnMaterial`; issue 22, item 1).
+//! `hylc yarn [FILE]`: the yarn parameters as JSON (`hylc::rod::YarnMaterial`; docs/yarn-parameters.md).
 
 use hylc::rod::YarnMaterial;
 use std::path::PathBuf;

@@ -1,4 +1,4 @@
-//! Checking a sampling plan (`../shared/design/04-sampling-fitting.md`, "Sampling plan (C4)"; issue 17): the
+//! Checking a sampling plan (`../shared/design/04-sampling-fitting.md`, "Sampling plan (C4)"; docs/robustness.md): the
 //! admissible strains and sizes of a plan, [`Plan::validate`], and reading plan JSON with errors that name the
 //! file and field ([`Plan::from_json`], [`Plan::load`]).
 

@@ -1,4 +1,4 @@
-//! ARCSim-HYLC's handlebars (issue 18, "Semantics you must reproduce exactly"): a strip on one side of the
+//! ARCSim-HYLC's handlebars (docs/arcsim.md, "Handlebars"): a strip on one side of the
 //! cloth's rest bounding box, placed by fractions of the box's extents.
 
 use crate::shell::scene::Selection;

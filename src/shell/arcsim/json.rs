@@ -1,4 +1,4 @@
-//! The JSON dialect of ARCSim scene files (issue 18, "comments allowed"): standard JSON plus `//` line and
+//! The JSON dialect of ARCSim scene files (docs/arcsim.md): standard JSON plus `//` line and
 //! `/* */` block comments, trailing commas before `]`/`}`, and the bare words `NaN`, `Infinity`, `-Infinity`
 //! (read as numbers so that the converter can name the key that holds them instead of failing on syntax).
 //! Every value keeps the line it starts on, so that errors and warnings can point at it.

@@ -1,6 +1,6 @@
 //! Typed access to the values of an ARCSim scene with errors and warnings that name the file, the line and the
-//! key's path (issue 18, "Unknown ARCSim keys: a one-line warning naming the key; malformed ones: a one-line
-//! error with the file and key").
+//! key's path (docs/arcsim.md, "Ignored keys and errors": unknown keys get a one-line warning naming the key,
+//! malformed ones a one-line error with the file and key).
 
 use super::json::{Node, Value};
 use crate::shell::ShellError;

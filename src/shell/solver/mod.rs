@@ -1,4 +1,4 @@
-//! The cloth solver (`05-macro.md`, "The cloth solver"; issue 18): implicit Euler as minimisation of the
+//! The cloth solver (`05-macro.md`, "The cloth solver"; docs/cloth-simulator.md): implicit Euler as minimisation of the
 //! incremental potential, adaptive substeps, and a quasi-static mode.
 //!
 //! Per (sub)step of length h, with x̃ = xₙ + h vₙ, the free dofs minimise

@@ -1,4 +1,4 @@
-//! Conventions first (issue 22, item 4): before fitting, every convention that could move the compared
+//! Conventions first (docs/yarn-parameters.md): before fitting, every convention that could move the compared
 //! displacements without any yarn parameter, each switched on its own, with the error at the six grid points
 //! nearest z = 0 (the start point's neighbours), compared as `micro-grid` compares them.
 //!

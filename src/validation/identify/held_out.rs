@@ -1,6 +1,6 @@
-//! The validation numbers of issue 22, item 5 for one parameter set: the full 9×9×9 grid against the original's
-//! displacements (RMS / max position error, per axis value) and the original material's five 1D curves against
-//! our Ψ̄ (relative RMS over the original's range, no free factor).
+//! The validation numbers of an identified parameter set (docs/yarn-parameters.md): the full 9×9×9 grid against
+//! the original's displacements (RMS / max position error, per axis value) and the original material's five 1D
+//! curves against our Ψ̄ (relative RMS over the original's range, no free factor).
 
 use super::residuals::curve_values;
 use super::IdentifyError;
@@ -134,7 +134,7 @@ pub fn held_out(
     })
 }
 
-/// What drives the fit along one 1D range (issue 22, item 6): θ ∂Ψ̄/∂θ (J/m² per unit ln θ) at each strain for
+/// What drives the fit along one 1D range (docs/yarn-parameters.md): θ ∂Ψ̄/∂θ (J/m² per unit ln θ) at each strain for
 /// θ = Y, G, γ, k_c, f (envelope theorem at the equilibrium).
 #[derive(Clone, Debug, Serialize)]
 pub struct StudyCurve {

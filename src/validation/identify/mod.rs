@@ -1,5 +1,5 @@
-//! Identification of the yarn parameters from the original's data with the solver's own derivatives (issue 22,
-//! items 3 and 4; `../shared/design/06-verification.md`, section 3).
+//! Identification of the yarn parameters from the original's data with the solver's own derivatives (docs/yarn-parameters.md,
+//! "Identifying the yarn parameters").
 //!
 //! Unknowns q = (ln Y, ln γ, ln G/Y, ln k_c, ln f) (f the contact radius factor; each can be held fixed), on a
 //! box of admissible values ([`BOUNDS`]): a trial step that leaves it is clamped to it, and the iteration says so.

@@ -1,4 +1,4 @@
-//! PNG plots of `hylc identify` (issue 22, item 3): line plots of several series (our 1D curves against the
+//! PNG plots of `hylc identify` (docs/yarn-parameters.md): line plots of several series (our 1D curves against the
 //! original's, the displacement error per grid axis value before and after), drawn with plotters' bitmap backend.
 //! [`write_plots`] and [`plot_study`] write the files of an identification.
 

@@ -1,4 +1,4 @@
-//! The residual sets of `hylc identify` (issue 22, item 3) with their Jacobians with respect to the yarn
+//! The residual sets of `hylc identify` (docs/yarn-parameters.md) with their Jacobians with respect to the yarn
 //! parameters, from the solver's own derivatives:
 //!
 //! - (a) the equilibrium residual at the pattern's stored state: r_a = w_a ∇E / N with
