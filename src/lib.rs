@@ -1,6 +1,6 @@
 //! hylc — homogenized yarn-level cloth.
 //!
-//! Stages follow the data flow of `../shared/design/01-architecture.md`. Layers import downwards only (a test,
+//! Stages follow the data flow of `docs/layout.md`. Layers import downwards only (a test,
 //! `tests/layers.rs`, fails on an import against this order); each group below may use the groups above it:
 //!
 //! 1. foundations: [`sparse`] (lower-triangle sparse patterns of the Newton matrices), [`strain`] (strain

@@ -1,4 +1,4 @@
-//! Periodic-tile types (`../shared/design/03-homogenization.md`, section 1), shared by the rods, the contact broad
+//! Periodic-tile types (`docs/micro-solver.md`, section 1), shared by the rods, the contact broad
 //! phase and the tile: an offset o = (o₁, o₂) names the periodic copy of the tile φ(ξ + (o₁p₁, o₂p₂)) = T_o φ(ξ),
 //! with T_o: x ↦ R_o x + t_o a rigid motion (a translation by (o₁p₁, o₂p₂, 0) at zero macro strain, a rotation
 //! about the cylinder axis for the bending maps).
@@ -63,7 +63,7 @@ impl Placement for Translation {
 pub const MAX_OFFSET: i32 = 3;
 
 /// Rigid tile transforms T_o(x) = R_o x + t_o of the periodic copies, tabulated for offsets |oᵢ| ≤
-/// [`MAX_OFFSET`] (`03-homogenization.md`, section 1: φ(ξ + (o₁p₁, o₂p₂)) = T_o φ(ξ)). Translations at zero
+/// [`MAX_OFFSET`] (`docs/micro-solver.md`, section 1: φ(ξ + (o₁p₁, o₂p₂)) = T_o φ(ξ)). Translations at zero
 /// macro strain; rotations about the cylinder axis for the bending maps.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TileTransforms {
@@ -138,7 +138,7 @@ impl Placement for TileTransforms {
 }
 
 /// One periodic copy of the tile: the rigid motion x ↦ R x + t that maps the tile onto its copy at offset
-/// (dx, dy) (`03-homogenization.md`: φ(ξ + (dx p₁, dy p₂)) = T φ(ξ)).
+/// (dx, dy) (`docs/micro-solver.md`: φ(ξ + (dx p₁, dy p₂)) = T φ(ξ)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TileImage {
     /// Periodic offset (dx, dy) of the copy.

@@ -1,5 +1,5 @@
 //! The scalar type of the reference implementations and plain 3-vector arithmetic over it: the bottom layer,
-//! used by the rods, the contact kernels, the shell and the renderer (`../shared/design/06-verification.md`,
+//! used by the rods, the contact kernels, the shell and the renderer (`docs/derivative-harness.md`,
 //! section 1: every energy has a reference implementation generic over the scalar type).
 
 use num_dual::DualNum;

@@ -1,5 +1,5 @@
 //! Lower-triangle sparsity patterns of symmetric Newton matrices, in faer's compressed-sparse-column layout
-//! (`../shared/design/01-architecture.md`, "Dependencies": faer's sparse Cholesky with a reused symbolic
+//! (`docs/layout.md`, "Dependencies": faer's sparse Cholesky with a reused symbolic
 //! analysis). The bottom layer shared by the micro solver's KKT system (`micro::linear`) and the cloth solver's
 //! assembly (`shell::assemble`): both describe their matrix by the rows of each column, and this module turns
 //! that into column pointers, sorted row indices and the value slot of every diagonal entry.

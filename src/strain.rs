@@ -1,4 +1,4 @@
-//! Strain components by name (`../shared/design/03-homogenization.md`, section 1; `05-macro.md`, "Strains").
+//! Strain components by name (`docs/micro-solver.md`, section 1; `docs/cloth-simulator.md`, "Strains").
 //!
 //! The micro problem and the material's terms know five components, z = (s_x, s_a, s_y, Π₀₀, Π₁₁): the stretches
 //! along ξ₁ and ξ₂, the cosine of the angle between the stretched material axes, and the curvatures of bending

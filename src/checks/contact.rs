@@ -1,4 +1,4 @@
-//! Harness rows for the contact pair energy (`06-verification.md`, section 1).
+//! Harness rows for the contact pair energy (`docs/derivative-harness.md`, section 1).
 //!
 //! Inputs: the 12 coordinates (x_a0, x_a1, x_b0, x_b1); k_c, r, l̄_a, l̄_b and Q are fixed per row.
 //!

@@ -1,7 +1,7 @@
-//! Harness rows for the material (`06-verification.md`, section 1): the 1D and 2D Hermite splines, the bending
+//! Harness rows for the material (`docs/derivative-harness.md`, section 1): the 1D and 2D Hermite splines, the bending
 //! matrix-function terms (1D and 2D, both components) and ψ itself.
 //!
-//! Scales (the `scale` of the tolerance test, `06-verification.md`): the magnitude of the function's spline data,
+//! Scales (the `scale` of the tolerance test, `docs/derivative-harness.md`): the magnitude of the function's spline data,
 //! V = |C₀| + Σ_terms max|p| (J/m²), because round-off in evaluating a piecewise polynomial is proportional to its
 //! coefficients, not to its value (a residual 2D term is ~1e-8 near its axes while its data are ~1e-2). Gradient
 //! and Hessian scales are V/σ and V/σ² with σ the smallest strain scale among the inputs the function uses.

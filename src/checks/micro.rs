@@ -1,4 +1,4 @@
-//! Harness row for the reduced micro energy E(C̃y + d̃) (`06-verification.md`, section 1): every unknown of a
+//! Harness row for the reduced micro energy E(C̃y + d̃) (`docs/derivative-harness.md`, section 1): every unknown of a
 //! small generated pattern at once, under an in-plane strain and under bending along each axis. The strain is a
 //! fixed parameter of each case (cases cycle through the three), so one row covers all three maps at the cost of
 //! one whole-tile row.

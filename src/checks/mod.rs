@@ -1,4 +1,4 @@
-//! The derivative-check registry (`../shared/design/06-verification.md`, section 1): every energy of the project
+//! The derivative-check registry (`docs/derivative-harness.md`, section 1): every energy of the project
 //! under the harness of [`crate::diff`], one file per stage. This layer sits above every energy so that the
 //! harness itself depends on nothing but the scalar type.
 

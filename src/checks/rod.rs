@@ -1,4 +1,4 @@
-//! Harness rows for the rod stencils (`06-verification.md`, section 1): stretching and bending+twisting with frame
+//! Harness rows for the rod stencils (`docs/derivative-harness.md`, section 1): stretching and bending+twisting with frame
 //! transport.
 //!
 //! Samples carry the stencil's stored state as harness parameters (never differentiated): the stored frames come

@@ -1,4 +1,4 @@
-//! Harness rows of the macro scale (`06-verification.md`, section 1): the strain chain z(q) of a triangle stencil
+//! Harness rows of the macro scale (`docs/derivative-harness.md`, section 1): the strain chain z(q) of a triangle stencil
 //! (as the scalar w·z(q) for a weight vector w, so its gradient is Jᵀw and its Hessian the contraction
 //! Σ_k w_k ∇²z_k; unit weights give each row of the Jacobian and each slice of the 6×18×18 tensor), the triangle
 //! energy A·ψ(z(q)), and the assembled energy of a small mesh.

@@ -1,4 +1,4 @@
-//! Harness rows of the cloth solver's non-elastic terms (docs/cloth-simulator.md; `06-verification.md`, section 1): air drag
+//! Harness rows of the cloth solver's non-elastic terms (docs/cloth-simulator.md; `docs/derivative-harness.md`, section 1): air drag
 //! per face, stiffness-proportional damping per face, the obstacle penalty against a sphere, a plane and a
 //! triangle mesh (faces, edges and vertices), and lagged Coulomb friction.
 //!

@@ -1,4 +1,4 @@
-//! Harness row for the whole-tile energy (`06-verification.md`, section 1): every dof of a small generated pattern
+//! Harness row for the whole-tile energy (`docs/derivative-harness.md`, section 1): every dof of a small generated pattern
 //! at once, stretching + bending + twisting + contact, with the frames stored at the pattern's state.
 //!
 //! Reference: the plain sum of the stencils' generic reference twins over the same stencils and contact pairs.

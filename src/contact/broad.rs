@@ -1,5 +1,5 @@
-//! Periodic broad phase for yarn–yarn contact (`../shared/design/02-yarn-model.md`, "Yarn-yarn contact";
-//! tile transforms in `03-homogenization.md`, section 1).
+//! Periodic broad phase for yarn–yarn contact (`docs/yarn-model.md`, "Yarn-yarn contact";
+//! tile transforms in `docs/micro-solver.md`, section 1).
 //!
 //! Segment i of a tile is the outgoing edge of vertex i of a [`Pattern`], given by its two world endpoints (the end
 //! is the periodic copy of the end vertex, see [`tile_segments`]). The tile repeats under rigid tile transforms

@@ -1,4 +1,4 @@
-//! Yarn–yarn contact (`../shared/design/02-yarn-model.md`, "Yarn-yarn contact").
+//! Yarn–yarn contact (`docs/yarn-model.md`, "Yarn-yarn contact").
 //!
 //! The Kaldor–James–Marschner (2008) penalty between two straight segments a and b,
 //!

@@ -1,4 +1,4 @@
-//! The Kaldor contact energy of one segment pair (`../shared/design/02-yarn-model.md`, "Yarn-yarn contact"):
+//! The Kaldor contact energy of one segment pair (`docs/yarn-model.md`, "Yarn-yarn contact"):
 //! fast value, fast value + gradient + exact Hessian, and the generic reference twin for the derivative harness.
 //!
 //! Inputs are the 12 coordinates (x_a0, x_a1, x_b0, x_b1) in this order; the kernel carries k_c, r and the
@@ -184,7 +184,7 @@ impl PairKernel {
     }
 
     /// ∂E_ab/∂r at fixed points: with u = d²/(4r²) each term (1 − u)²/u changes by 2(1 − u²)/(u r) per unit
-    /// radius (the yarn-radius sensitivity of `03-homogenization.md`, section 5).
+    /// radius (the yarn-radius sensitivity of `docs/micro-solver.md`, section 5).
     pub fn radius_derivative(
         &self,
         x: &[Vector3<f64>; 4],
@@ -538,7 +538,7 @@ mod tests {
         assert!((e - r).abs() <= 1e-13 * e, "{e} vs {r}");
     }
 
-    /// One-sided consistency at the kink ρ = 1 (`06-verification.md`: C¹ functions are checked at their kinks):
+    /// One-sided consistency at the kink ρ = 1 (`docs/derivative-harness.md`: C¹ functions are checked at their kinks):
     /// with a single node pair (Q = 1) moved across the cut-off, value and gradient tend to 0 from inside and are 0
     /// outside; the one-sided Hessian from inside tends to W f''(1)/(2r)² along the normal.
     #[test]

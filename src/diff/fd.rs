@@ -1,4 +1,4 @@
-//! Central finite differences with one Richardson extrapolation step (`06-verification.md`, section 1).
+//! Central finite differences with one Richardson extrapolation step (`docs/derivative-harness.md`, section 1).
 //!
 //! `D(h) = (f(x + h eᵢ) − f(x − h eᵢ)) / 2h` has error `O(h²)`; `(4 D(h/2) − D(h)) / 3` cancels it, leaving
 //! `O(h⁴)` truncation and `O(ε |f| / h)` round-off.

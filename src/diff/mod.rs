@@ -1,4 +1,4 @@
-//! Derivative-check harness (`../shared/design/06-verification.md`, section 1).
+//! Derivative-check harness (`docs/derivative-harness.md`, section 1).
 //!
 //! Every hand-written gradient and Hessian in the project is compared with
 //! 1. forward-mode automatic differentiation (num-dual, second order) of a plain *reference* implementation that is
@@ -27,7 +27,7 @@ use rayon::prelude::*;
 
 pub use crate::real::{c, Real};
 
-/// The tolerances of `06-verification.md`, section 1 (relative, normwise).
+/// The tolerances of `docs/derivative-harness.md`, section 1 (relative, normwise).
 #[derive(Clone, Copy, Debug)]
 pub struct Tolerances {
     /// fast value against the reference value evaluated in f64
@@ -42,7 +42,7 @@ pub struct Tolerances {
     pub hessian_fd: f64,
 }
 
-/// The policy of `06-verification.md`. Never loosen these to make a check pass.
+/// The policy of `docs/derivative-harness.md`. Never loosen these to make a check pass.
 pub const POLICY: Tolerances = Tolerances {
     value: 1e-12,
     gradient_ad: 1e-9,

@@ -1,4 +1,4 @@
-//! FIT1D (`04-sampling-fitting.md`, "Fitting (C5, C6, C7)", steps 1–6): one 1D term f_k of the material from
+//! FIT1D (`docs/fitting.md`, "Fitting (C5, C6, C7)", steps 1–6): one 1D term f_k of the material from
 //! samples (X, Ψ) of its 1D strain range (X already normalised by the strain scale).
 //!
 //! 1. g(u) = symexp(MLS(u | X, symlog Ψ)), ε = `eps_rel` · max|Ψ|; symmetrised MLS for s_a.

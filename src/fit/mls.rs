@@ -1,4 +1,4 @@
-//! 1D moving least squares (FIT1D step 1, `04-sampling-fitting.md`, "Fitting (C5, C6, C7)"): at each evaluation
+//! 1D moving least squares (FIT1D step 1, `docs/fitting.md`, "Fitting (C5, C6, C7)"): at each evaluation
 //! point u a quadratic in (x − u) is fitted to the samples by weighted least squares with Gaussian weights
 //! exp(−(x − u)²/(2b²)), and its value at u is the result. The bandwidth b is a factor (default 2) times the median
 //! spacing of the sorted sample abscissae. Because the local model is a full quadratic, quadratic data are

@@ -1,4 +1,4 @@
-//! Fitting the spline material from samples (C5–C7, `../shared/design/04-sampling-fitting.md`, section
+//! Fitting the spline material from samples (C5–C7, `docs/fitting.md`, section
 //! "Fitting (C5, C6, C7)"): the symlog transform ([`symlog`]), moving least squares in 1D and 2D ([`mls`]),
 //! FIT1D ([`fit1d`]) and FIT2D ([`fit2d`]), which work on any samples, synthetic ones included, and FITSPLINES
 //! ([`model`]), which fits a whole material to the samples of a plan.

@@ -1,4 +1,4 @@
-//! FITSPLINES (Algorithm C5; `04-sampling-fitting.md`, "Fitting (C5, C6, C7)"): the whole material
+//! FITSPLINES (Algorithm C5; `docs/fitting.md`, "Fitting (C5, C6, C7)"): the whole material
 //! ψ(z) = f₀ + Σ_k f_k(z_k/σ_k) + Σ_(k,l) f_kl(z_k/σ_k, z_l/σ_l) from the samples of one plan.
 //!
 //! - Strain scales σ_k = max |z_k| over the plan's samples (1 for a strain the plan never varies).

@@ -1,4 +1,4 @@
-//! PNG plots of a fitted material (`04-sampling-fitting.md`, "Quality report"): each 1D term with its samples, the
+//! PNG plots of a fitted material (`docs/fitting.md`, "Quality report"): each 1D term with its samples, the
 //! MLS curve g and the spline f₀ + f_k; each 2D term as two heat maps, the fitted surface f and the residual term
 //! the material stores, with the samples that failed marked. Drawn with plotters' bitmap backend.
 

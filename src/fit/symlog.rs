@@ -1,4 +1,4 @@
-//! The symmetric logarithm used by FIT1D step 1 (`04-sampling-fitting.md`, "Fitting (C5, C6, C7)"):
+//! The symmetric logarithm used by FIT1D step 1 (`docs/fitting.md`, "Fitting (C5, C6, C7)"):
 //! symlog(v) = sgn(v) ln(1 + |v|/ε) and its inverse symexp(w) = sgn(w) ε (e^|w| − 1). It compresses the range of
 //! energies that grow by orders of magnitude over a strain range while staying linear (slope 1/ε) near 0.
 

@@ -1,4 +1,4 @@
-//! Procedural generators of the embedded default patterns (`../shared/design/02-yarn-model.md`, "Periodic yarn
+//! Procedural generators of the embedded default patterns (`docs/yarn-model.md`, "Periodic yarn
 //! pattern": "the project also generates patterns itself … at least a plain weave (and a weave matrix for
 //! twill/satin/basket) and a stockinette knit, as smooth periodic centre-line curves sampled at about one vertex per
 //! yarn radius").
@@ -677,7 +677,7 @@ pub struct MinDistance {
 
 /// The minimum distance between the centre-line segments of a pattern, over all periodic copies (brute force over
 /// every pair and every copy that can come closer than two periods). Contact needs at least 2r
-/// (`02-yarn-model.md`, "Yarn-yarn contact").
+/// (`docs/yarn-model.md`, "Yarn-yarn contact").
 ///
 /// Segments on the same physical yarn are recognised through the periodic continuation: a home-tile segment of
 /// vertex v lies on the copy of its yarn shifted by −C(v), where C(v) is the sum of the edge offsets from the
@@ -835,7 +835,7 @@ pub fn to_obj(p: &Pattern) -> String {
     out
 }
 
-/// The small generated patterns the whole-tile derivative harness runs on (`06-verification.md`: "the total micro
+/// The small generated patterns the whole-tile derivative harness runs on (`docs/derivative-harness.md`: "the total micro
 /// energy … on a small pattern"): the default plain weave (40 vertices, 160 dofs, yarns touching at crossings).
 pub fn harness_patterns() -> Vec<(&'static str, Pattern)> {
     vec![(

@@ -1,5 +1,5 @@
-//! Cubic and bicubic Hermite splines with the original's linear extrapolation (`05-macro.md`, "Material ψ(z)";
-//! storage in `04-sampling-fitting.md`, "Material JSON").
+//! Cubic and bicubic Hermite splines with the original's linear extrapolation (`docs/material.md`, "Material ψ(z)";
+//! storage in `docs/material.md`, "Material JSON").
 //!
 //! A spline is stored as knots plus values and slopes. For evaluation the knot line is split into *pieces*:
 //! piece 0 is the left exterior (x < t₀), pieces 1..n−1 the cells [tᵢ, tᵢ₊₁], piece n the right exterior

@@ -1,4 +1,4 @@
-//! Reading and writing the original material JSON (`04-sampling-fitting.md`, "Material JSON").
+//! Reading and writing the original material JSON (`docs/material.md`, "Material JSON").
 //!
 //! Numbers round-trip exactly (serde_json with `float_roundtrip` parses correctly rounded and writes the shortest
 //! representation that reads back to the same bits). Unknown top-level keys (e.g. "meta", "strain shift") are kept

@@ -1,5 +1,5 @@
-//! The spline material ψ(z) of the original method (`05-macro.md`, "Material ψ(z)"; file format in
-//! `04-sampling-fitting.md`, "Material JSON").
+//! The spline material ψ(z) of the original method (`docs/material.md`, "Material ψ(z)"; file format in
+//! `docs/material.md`, "Material JSON").
 //!
 //! z = (s_x, s_a, s_y, II₀₀, II₀₁, II₁₁), σ the five strain scales, L = [[II₀₀, II₀₁], [II₀₁, II₁₁]]:
 //!

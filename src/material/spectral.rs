@@ -1,4 +1,4 @@
-//! Bending terms as 2×2 symmetric matrix functions (`05-macro.md`, "Material ψ(z)").
+//! Bending terms as 2×2 symmetric matrix functions (`docs/material.md`, "Material ψ(z)").
 //!
 //! For a symmetric L = [[L₀₀, L₀₁], [L₀₁, L₁₁]] with eigenvalues λ₁,₂ = m ± d, where m = (L₀₀ + L₁₁)/2,
 //! δ = (L₀₀ − L₁₁)/2, b = L₀₁ and d = √(δ² + b²), the spectral matrix function f(L) = Σᵢ f(λᵢ) vᵢvᵢᵀ is

@@ -1,4 +1,4 @@
-//! Kinematics and the elimination map q = C̃ y + d̃ (`03-homogenization.md`, section 2).
+//! Kinematics and the elimination map q = C̃ y + d̃ (`docs/micro-solver.md`, section 2).
 //!
 //! Unknowns y = (ũ₀ … ũ_{n−1}, θ₀ … θ_{n−1}): one local displacement per vertex and one angle per edge. The
 //! world position of the copy of vertex v at offset o is

@@ -1,4 +1,4 @@
-//! Derivatives of Ψ̄ at an equilibrium by the envelope theorem (`03-homogenization.md`, section 5):
+//! Derivatives of Ψ̄ at an equilibrium by the envelope theorem (`docs/micro-solver.md`, section 5):
 //! dΨ̄/dp = (1/(p₁p₂)) ∂E/∂p (y*, p) at fixed unknowns, for the strain components and the yarn parameters.
 //!
 //! Strain: at fixed y every vertex copy moves with the map, x = T_o(b_v(z) + R_v(z) ũ_v). Split into the motion
@@ -165,7 +165,7 @@ pub fn parameter_derivatives(
 }
 
 /// Second derivatives of Ψ̄ with respect to the strain components of a state's family, and the sensitivity of
-/// the equilibrium unknowns (`03-homogenization.md`, section 5).
+/// the equilibrium unknowns (`docs/micro-solver.md`, section 5).
 #[derive(Clone, Debug)]
 pub struct StrainStiffness {
     /// The strain components (indices into z) of the rows and columns.

@@ -1,4 +1,4 @@
-//! The constrained Newton system (`03-homogenization.md`, section 3):
+//! The constrained Newton system (`docs/micro-solver.md`, section 3):
 //!
 //! [ H + μ I   Aᵀ ] [ δy ]   [ −g ]
 //! [ A          0 ] [ λ  ] = [  0 ]

@@ -1,4 +1,4 @@
-//! Micro scale: homogenization of one periodic tile (`../shared/design/03-homogenization.md`, Algorithms C1–C3).
+//! Micro scale: homogenization of one periodic tile (`docs/micro-solver.md`, Algorithms C1–C3).
 //!
 //! Data flow: a macro strain ([`strain`]) selects a closed-form surface map ([`surface`]); the kinematics
 //! ([`elimination`]) place every vertex copy affinely in the unknowns; the Newton solver ([`solver`]) with its

@@ -1,4 +1,4 @@
-//! The micro solver's settings (`03-homogenization.md`, section 4): [`SolverOptions`], the Newton step rule
+//! The micro solver's settings (`docs/micro-solver.md`, section 4): [`SolverOptions`], the Newton step rule
 //! [`StepRule`] and the crossing guard [`CrossingGuard`].
 //!
 //! **Settings files.** The settings are written as JSON with a `version` key ([`SETTINGS_VERSION`], every key
@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 /// The settings format written now (the `version` key of a settings object).
 pub const SETTINGS_VERSION: u32 = 2;
 
-/// Solver settings (`03-homogenization.md`, section 4; defaults from there).
+/// Solver settings (`docs/micro-solver.md`, section 4; defaults from there).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SolverOptions {
     /// Dimensionless force tolerance: converged when ‖g‖_∞ ≤ tolerance · k_s.
@@ -67,7 +67,7 @@ impl Default for SolverOptions {
     }
 }
 
-/// How a Newton step treats a Hessian H that is not positive definite (`03-homogenization.md`, section 3; issue
+/// How a Newton step treats a Hessian H that is not positive definite (`docs/micro-solver.md`, section 3; issue
 /// 20).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]

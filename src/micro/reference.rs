@@ -1,4 +1,4 @@
-//! The reference state of a pattern (Algorithm C1; `03-homogenization.md`, section 6):
+//! The reference state of a pattern (Algorithm C1; `docs/micro-solver.md`, section 6):
 //! 1. stress-free state: repeat { rest values ← current values; relax at zero strain } until the relaxed energy is
 //!    below 1e-10 · k_s · (mean rest length) — contacts resolved, the rest shape equals the shape;
 //! 2. tension: knitted patterns get rest lengths × 0.9 and rest curvatures × 0.8, woven ones rest curvatures × 0.9

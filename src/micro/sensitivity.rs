@@ -1,4 +1,4 @@
-//! Equilibrium sensitivities to the yarn parameters (docs/yarn-parameters.md; `03-homogenization.md`, section 5):
+//! Equilibrium sensitivities to the yarn parameters (docs/yarn-parameters.md; `docs/micro-solver.md`, section 5):
 //! dy*/dθ for every continuous yarn parameter θ by the implicit-function theorem at a converged equilibrium,
 //! with one factorisation of the Newton matrix.
 //!

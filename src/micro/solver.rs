@@ -1,4 +1,4 @@
-//! The micro-scale Newton solver (Algorithms C2, C3; `03-homogenization.md`, sections 2–4).
+//! The micro-scale Newton solver (Algorithms C2, C3; `docs/micro-solver.md`, sections 2–4).
 //!
 //! A [`MicroProblem`] holds one pattern (its reference state), the yarn material and the solver options; its
 //! [`solve`](MicroProblem::solve) finds the yarn equilibrium at a macro strain, cold from the reference state or
@@ -205,7 +205,7 @@ impl MicroProblem {
         }
     }
 
-    /// The null-space constraint rows A (`03-homogenization.md`, section 3).
+    /// The null-space constraint rows A (`docs/micro-solver.md`, section 3).
     pub fn constraints(&self) -> &[Vec<f64>] {
         &self.constraints
     }
@@ -754,7 +754,7 @@ pub fn local(y: &[f64], v: usize) -> Vector3<f64> {
     Vector3::new(y[3 * v], y[3 * v + 1], y[3 * v + 2])
 }
 
-/// The null-space constraint rows (`03-homogenization.md`, section 3), each normalised to unit length: the
+/// The null-space constraint rows (`docs/micro-solver.md`, section 3), each normalised to unit length: the
 /// The strain after step `s` of `steps` equal steps from `from` to `target` (exactly `target` at the last).
 pub(super) fn move_strain(
     from: &MacroStrain,

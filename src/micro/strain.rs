@@ -1,4 +1,4 @@
-//! The macro strain a micro solve is asked for (`03-homogenization.md`, section 1): z = (s_x, s_a, s_y, Π₀₀, Π₁₁),
+//! The macro strain a micro solve is asked for (`docs/micro-solver.md`, section 1): z = (s_x, s_a, s_y, Π₀₀, Π₁₁),
 //! checked against the admissible set before any work is done.
 
 use serde::{Deserialize, Serialize};
@@ -12,7 +12,7 @@ pub use crate::strain::StrainComponent;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MacroStrain(pub [f64; 5]);
 
-/// Which closed-form surface map embeds the tile (`03-homogenization.md`, section 1). `BendY` with Π₁₁ = 0 is
+/// Which closed-form surface map embeds the tile (`docs/micro-solver.md`, section 1). `BendY` with Π₁₁ = 0 is
 /// exactly the in-plane map φ = F ξ; `BendX` with Π₀₀ = 0 is the in-plane map rotated in the plane.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Family {
@@ -73,7 +73,7 @@ impl MacroStrain {
     }
 
     /// Check the strain: finite, 1 + s_x and 1 + s_y in [[`MIN_STRETCH`], [`MAX_STRETCH`]], |s_a| < 1,
-    /// |Π₀₀|, |Π₁₁| ≤ [`MAX_CURVATURE`], and at most one bending non-zero (`03-homogenization.md`, section 1).
+    /// |Π₀₀|, |Π₁₁| ≤ [`MAX_CURVATURE`], and at most one bending non-zero (`docs/micro-solver.md`, section 1).
     pub fn validate(&self) -> Result<Family, StrainError> {
         let z = self.0;
         let err = |m: String| {
@@ -150,7 +150,7 @@ impl MacroStrain {
         [[a * a, a * b * c], [a * b * c, b * b]]
     }
 
-    /// The smaller eigenvalue of Ī (the displacement limit of `03-homogenization.md`, section 4).
+    /// The smaller eigenvalue of Ī (the displacement limit of `docs/micro-solver.md`, section 4).
     pub fn min_stretch_eigenvalue(&self) -> f64 {
         let [[p, q], [_, r]] = self.first_fundamental_form();
         let m = 0.5 * (p + r);

@@ -1,4 +1,4 @@
-//! The deformed mid-surface φ, its frame field R and the tile transforms (`03-homogenization.md`, section 1).
+//! The deformed mid-surface φ, its frame field R and the tile transforms (`docs/micro-solver.md`, section 1).
 //!
 //! With a = 1 + s_x, b = 1 + s_y, c = s_a:
 //! - `BendY` (rulings along ξ₁, curvature k = Π₁₁ along ξ₂; the plane φ = F ξ when k = 0), α' = b√(1−c²),

@@ -1,11 +1,11 @@
-//! Periodic yarn patterns (`../shared/design/02-yarn-model.md`, "Periodic yarn pattern").
+//! Periodic yarn patterns (`docs/yarn-model.md`, "Periodic yarn pattern").
 //!
 //! A [`Pattern`] is one rectangular tile of yarn repeating with periods p₁ (along ξ₁ = x) and p₂ (along ξ₂ = y).
 //! Every vertex has exactly one outgoing and one incoming edge, so yarns are closed chains once periodicity is
 //! taken into account, and edge `i` is the outgoing edge of vertex `i` (the `.pyp` file may list edges in any
 //! order; the file order is kept in [`Pattern::edge_file_order`] so that a written file lists them the same way).
 //!
-//! Conventions (verified against the original data, see `02-yarn-model.md`): the edge of vertex `i` runs from
+//! Conventions (verified against the original data, see `docs/yarn-model.md`): the edge of vertex `i` runs from
 //! `X[i]` to the copy of `X[end]` shifted by `(dx·p₁, dy·p₂, 0)`; its reference director and the material angle θ
 //! of vertex `i` belong to that outgoing edge; rest curvature, rest twist and reference twist belong to the bending
 //! stencil centred at vertex `i` (incoming edge, vertex, outgoing edge).
@@ -139,7 +139,7 @@ impl Pattern {
     }
 
     /// Areal mass density ρ_A = ρ π r² (total rest yarn length) / (p₁ p₂) (kg/m²) for yarn density `rho` (kg/m³)
-    /// (`04-sampling-fitting.md`, "Material JSON").
+    /// (`docs/sampling.md`, "Material JSON").
     pub fn areal_density(&self, rho: f64) -> f64 {
         rho * std::f64::consts::PI * self.radius * self.radius * self.total_rest_length()
             / (self.periods[0] * self.periods[1])

@@ -1,4 +1,4 @@
-//! Bending+twisting stencil (`02-yarn-model.md`, "Discrete elastic rods"): the vertex x¹ with its incoming edge
+//! Bending+twisting stencil (`docs/yarn-model.md`, "Discrete elastic rods"): the vertex x¹ with its incoming edge
 //! e⁰ = x¹ − x⁰ and outgoing edge e¹ = x² − x¹, 11 dofs (x⁰, x¹, x², θ⁰, θ¹), energy
 //!
 //! E = (B/(2 l̄)) ‖κ − κ̄‖² + (GJ/(2 l̄)) (m − m̄)²,
@@ -281,7 +281,7 @@ pub fn bend_twist_parts_vgh(
     ([eb.v, et.v], g, h)
 }
 
-/// Reference twin: the energy of the stencil, generic over the scalar, written like `02-yarn-model.md`.
+/// Reference twin: the energy of the stencil, generic over the scalar, written like `docs/yarn-model.md`.
 /// `x` = (x⁰, x¹, x², θ⁰, θ¹); frames are transported from `fr` with Rodrigues' rotation and the reference twist is
 /// the signed angle about t¹ from P(t⁰→t¹) u⁰ to u¹, continued from the stored value.
 pub fn bend_twist_reference<D: Real>(x: &[D], fr: &StencilFrames, p: &BendTwistParams) -> D {

@@ -1,5 +1,5 @@
 //! Checked entry points of the rod stencils (docs/robustness.md): the same value, gradient and Hessian as
-//! [`stretch_vgh`] and [`bend_twist_vgh`] (`02-yarn-model.md`, "Discrete elastic rods"), for inputs that do not come
+//! [`stretch_vgh`] and [`bend_twist_vgh`] (`docs/yarn-model.md`, "Discrete elastic rods"), for inputs that do not come
 //! from the solver's own state — every input is checked first (finite, within [`MAX_COORDINATE`], edges of
 //! positive length), and a result that is not finite (an overflow) is an error instead of NaN or inf.
 

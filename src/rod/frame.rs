@@ -1,4 +1,4 @@
-//! Frames, parallel transport, curvature binormal and reference twist (`02-yarn-model.md`, "Discrete elastic
+//! Frames, parallel transport, curvature binormal and reference twist (`docs/yarn-model.md`, "Discrete elastic
 //! rods"), as plain values and as hand-differentiated primitives (value, Jacobian, Hessian).
 
 use super::jet::{Jet, VJet};
@@ -13,7 +13,7 @@ pub fn transport(a: &Vector3<f64>, b: &Vector3<f64>, x: &Vector3<f64>) -> Vector
     x * c + k.cross(x) + k * (k.dot(x) / (1.0 + c))
 }
 
-/// How the discrete curvature measures the turning angle φ between two edges (`02-yarn-model.md`, "Discrete
+/// How the discrete curvature measures the turning angle φ between two edges (`docs/yarn-model.md`, "Discrete
 /// elastic rods"): the curvature binormal is κb = k(φ) b with b the unit binormal e⁰ × e¹ / |e⁰ × e¹|.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -89,7 +89,7 @@ pub fn angle_diff(a: f64, b: f64) -> f64 {
 }
 
 /// The continuous reference twist at a new state: the stored twist plus the change of the raw angle, wrapped, so
-/// it never jumps by 2π (`02-yarn-model.md`: "update it by the change of that angle").
+/// it never jumps by 2π (`docs/yarn-model.md`: "update it by the change of that angle").
 pub fn continuous_twist(stored: f64, raw_stored: f64, raw_new: f64) -> f64 {
     stored + angle_diff(raw_new, raw_stored)
 }

@@ -1,4 +1,4 @@
-//! Yarn material parameters (`../shared/design/02-yarn-model.md`, "Discrete elastic rods" and "Yarn-yarn
+//! Yarn material parameters (`docs/yarn-model.md`, "Discrete elastic rods" and "Yarn-yarn
 //! contact"): one struct that every yarn energy takes by reference, read from and written to JSON (docs/yarn-parameters.md,
 //! "Yarn parameters as data").
 //!

@@ -1,6 +1,6 @@
 //! Rods on a periodic pattern: the state the solver carries between accepted steps (positions, angles, the
 //! time-parallel reference frames and the continuous reference twists), the stencils it is cut into, and the
-//! rest values measured from a state (`02-yarn-model.md`, "Discrete elastic rods").
+//! rest values measured from a state (`docs/yarn-model.md`, "Discrete elastic rods").
 //!
 //! At zero macro strain a periodic copy of vertex v at offset o sits at X_v + (o₁p₁, o₂p₂, 0) and carries the same
 //! reference director; [`Placement`] abstracts this so that later stages can place copies on a curved mid-surface.
@@ -93,7 +93,7 @@ impl RodState {
     }
 
     /// Move to new positions and angles: transport every reference director from the current tangent to the new
-    /// one and continue every reference twist by its change (`02-yarn-model.md`: frames are updated in time).
+    /// one and continue every reference twist by its change (`docs/yarn-model.md`: frames are updated in time).
     pub fn advance<P: Placement>(
         &mut self,
         p: &Pattern,

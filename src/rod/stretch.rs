@@ -1,4 +1,4 @@
-//! Stretching stencil (`02-yarn-model.md`, "Energies"): E_s = ½ k_s l̄ (l/l̄ − 1)² for one edge, 6 dofs
+//! Stretching stencil (`docs/yarn-model.md`, "Energies"): E_s = ½ k_s l̄ (l/l̄ − 1)² for one edge, 6 dofs
 //! (x_start, x_end).
 
 use crate::real::Real;

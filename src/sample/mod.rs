@@ -1,4 +1,4 @@
-//! Sampling (`../shared/design/04-sampling-fitting.md`, section "Sampling plan (C4)"): plans ([`plan`]) and
+//! Sampling (`docs/sampling.md`, section "Sampling plan (C4)"): plans ([`plan`]) and
 //! running them on one pattern ([`run`]): parallel warm-started chains, an append-only sample file of
 //! [`record`]s, resume, shards and merging, the starts of a multi-start sample ([`starts`]); plans derived from
 //! the strains a macro run visited ([`scene`]). Sibling modules import one way: `record` ← `starts` ← `run`.

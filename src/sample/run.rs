@@ -1,4 +1,4 @@
-//! Running a sampling plan on one pattern (`../shared/design/04-sampling-fitting.md`, section "Sampling plan
+//! Running a sampling plan on one pattern (`docs/sampling.md`, section "Sampling plan
 //! (C4)", "Running a plan").
 //!
 //! - Chains ([`Plan::chains`]) run in parallel (rayon); each chain is sequential, so every sample's result depends

@@ -1,5 +1,5 @@
-//! Scene-driven sampling plans ("model only what a scene requires", `../shared/design/05-macro.md` and
-//! `04-sampling-fitting.md`, "Sampling plan (C4)"): from the strain extremes a macro run visited, a plan that
+//! Scene-driven sampling plans ("model only what a scene requires", `docs/cloth-simulator.md` and
+//! `docs/sampling.md`, "Sampling plan (C4)"): from the strain extremes a macro run visited, a plan that
 //! covers only those ranges plus a margin, at the sample spacing of a base plan.
 //!
 //! The macro strain z = (s_x, s_a, s_y, II₀₀, II₀₁, II₁₁) has three curvature components; the plan samples the

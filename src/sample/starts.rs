@@ -1,4 +1,4 @@
-//! Multi-start samples (docs/sampling.md, "Multi-start samples"; `../shared/design/04-sampling-fitting.md`, section
+//! Multi-start samples (docs/sampling.md, "Multi-start samples"; `docs/sampling.md`, section
 //! "Running a plan": "measure how far the two differ").
 //!
 //! - [`Starts::Warm`] (the default) solves each sample once, from its chain's warm start, and writes the records

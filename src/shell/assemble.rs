@@ -1,5 +1,5 @@
 //! Parallel assembly of the shell energy, gradient and Hessian into a fixed sparsity pattern
-//! (`05-macro.md`, "The cloth solver").
+//! (`docs/cloth-simulator.md`, "The cloth solver").
 //!
 //! The pattern is built once per mesh and set of constrained vertices: the Hessian of the free dofs, lower
 //! triangle, compressed sparse columns, with a 3×3 block for every pair of free vertices that share a stencil.

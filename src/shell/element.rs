@@ -1,4 +1,4 @@
-//! Triangle energy E_Δ = A·k·ψ(S z(q)), its gradient and Hessian (`05-macro.md`, "Per triangle"), with the
+//! Triangle energy E_Δ = A·k·ψ(S z(q)), its gradient and Hessian (`docs/cloth-simulator.md`, "Per triangle"), with the
 //! scene's modelling choices and the three Hessian options of the note.
 //!
 //! - k: stiffness multiplier; S = diag(1, 1, 1, β, β, β) with β the bending scale (multiplies II before ψ), as in
@@ -26,7 +26,7 @@ use super::strain::{
 use crate::material::Material;
 use nalgebra::{SMatrix, SymmetricEigen};
 
-/// How the local Hessian is made positive semi-definite (`05-macro.md`, options (a)–(c)).
+/// How the local Hessian is made positive semi-definite (`docs/cloth-simulator.md`, options (a)–(c)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Psd {

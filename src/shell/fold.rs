@@ -1,6 +1,6 @@
 //! The fold barrier (our addition to the HYLC shell model; docs/cloth-simulator.md): a hinge may not fold flat onto itself.
 //!
-//! The strain chain measures a hinge's dihedral angle θ ∈ (−π, π] with atan2 (`05-macro.md`, "Strain chain"), so
+//! The strain chain measures a hinge's dihedral angle θ ∈ (−π, π] with atan2 (`docs/cloth-simulator.md`, "Strain chain"), so
 //! when two neighbouring triangles fold through each other (|θ| → π, possible because the cloth has no
 //! self-contact) θ jumps by 2π and the bending energy jumps with it: Newton's line search then finds no decrease
 //! at any step length and the time step fails at every substep. Knits do this: the original stockinette's

@@ -1,4 +1,4 @@
-//! Triangle meshes of the cloth (`05-macro.md`, "Meshes"): generated rectangles (regular or randomly perturbed),
+//! Triangle meshes of the cloth (`docs/cloth-simulator.md`, "Meshes"): generated rectangles (regular or randomly perturbed),
 //! OBJ import, the triangle stencils (triangle + flap vertices), OBJ export.
 //!
 //! The rest (material) layout is flat: a rectangle is generated in its plane; an OBJ mesh must lie in a plane

@@ -1,5 +1,5 @@
 //! Macro scale: a triangle-mesh thin shell with the homogenized energy A·ψ(z(q)) per triangle, simulated by
-//! implicit Euler as incremental-potential minimisation (`../shared/design/05-macro.md`, Algorithm C8).
+//! implicit Euler as incremental-potential minimisation (`docs/cloth-simulator.md`, Algorithm C8).
 //!
 //! Data flow, one file per stage: [`strain`] (the strain chain z(q) of a triangle stencil) → [`element`]
 //! (triangle energy, gradient, Hessian, PSD options) → [`mesh`] (rectangles, OBJ, stencils) → [`assemble`]

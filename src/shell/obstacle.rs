@@ -1,4 +1,4 @@
-//! Rigid obstacles and the cloth's contact with them (`05-macro.md`, "The cloth solver"; docs/cloth-simulator.md): spheres,
+//! Rigid obstacles and the cloth's contact with them (`docs/cloth-simulator.md`, "The cloth solver"; docs/cloth-simulator.md): spheres,
 //! planes and triangle meshes, a smooth one-sided penalty per cloth vertex, and lagged Coulomb friction.
 //!
 //! **Distance.** d(p) is the signed distance of p to the obstacle's surface (positive outside) and n = ∇d its

@@ -1,4 +1,4 @@
-//! A small software rasteriser for snapshots of a simulated cloth (`01-architecture.md`, "outputs other tools
+//! A small software rasteriser for snapshots of a simulated cloth (`docs/layout.md`, "outputs other tools
 //! open"): orthographic view from an azimuth and elevation, z-buffer, two-sided Lambert shading, 2× supersampling,
 //! written as PNG. Obstacles are drawn as meshes ([`sphere_mesh`]) in their own colour.
 

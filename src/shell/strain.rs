@@ -1,4 +1,4 @@
-//! The strain chain z(q) of a triangle stencil (`05-macro.md`, "Strain chain z(q) of a triangle stencil").
+//! The strain chain z(q) of a triangle stencil (`docs/cloth-simulator.md`, "Strain chain z(q) of a triangle stencil").
 //!
 //! Stencil dofs q (18): x₀, x₁, x₂, then the flap vertices across edges (x₀,x₁), (x₁,x₂), (x₂,x₀). Output
 //! z = (s_x, s_a, s_y, II₀₀, II₀₁, II₁₁) with
@@ -515,7 +515,7 @@ fn add_hinge_hessian(hg: &Hinge, omega: f64, idx: [usize; 4], out: &mut [[f64; N
     scatter(&hb, idx, out);
 }
 
-/// Generic reference twin of z(q), written from the definitions of `05-macro.md` (absolute difference vectors,
+/// Generic reference twin of z(q), written from the definitions of `docs/cloth-simulator.md` (absolute difference vectors,
 /// atan2 for the angles).
 pub fn strain_reference<D: Real>(q: &[D], rest: &RestTriangle, flaps: [bool; 3]) -> [D; 6] {
     let x: [V3r<D>; 6] = std::array::from_fn(|v| real::v3(&q[3 * v..]));

@@ -1,5 +1,5 @@
 //! Contact part of the tile energy: the Kaldor pair kernel (`crate::contact`) summed over the tile's contact pairs
-//! (`02-yarn-model.md`, "Yarn-yarn contact").
+//! (`docs/yarn-model.md`, "Yarn-yarn contact").
 
 use super::{Tile, Want};
 use crate::contact::ccd::{crossings_between, Crossing};

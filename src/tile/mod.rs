@@ -1,4 +1,4 @@
-//! The whole periodic tile at zero macro strain (`02-yarn-model.md`): total rod + contact energy, its gradient and
+//! The whole periodic tile at zero macro strain (`docs/yarn-model.md`): total rod + contact energy, its gradient and
 //! its sparse Hessian, assembled stencil by stencil in parallel (rayon), with periodic copies as translations.
 //!
 //! Degrees of freedom: `[x₀, y₀, z₀, x₁, …, z_{n−1}, θ₀, …, θ_{n−1}]` — the home-tile vertex positions, then the
@@ -106,7 +106,7 @@ impl TileEval {
     }
 }
 
-/// How a vertex's three position dofs place it (`03-homogenization.md`, section 2): the home copy of vertex v is
+/// How a vertex's three position dofs place it (`docs/micro-solver.md`, section 2): the home copy of vertex v is
 /// at x_v = b_v + R_v ũ_v (b_v = φ(ξ_v) + h_v n(ξ_v), R_v = R(ξ_v)), and its copy at offset o at T_o(x_v).
 /// Without a map the dofs are the home positions themselves.
 #[derive(Clone, Debug, PartialEq)]
@@ -360,7 +360,7 @@ impl<'a> Tile<'a> {
     /// coordinates), plus, for each bending stencil whose incoming edge is a copy, g_θ⁰ t⁰ added to M of that
     /// copy's offset (the copy's stored frame turns with its tile transform: to first order at the stored state
     /// the same as turning θ⁰ by ω·t⁰). With an infinitesimal change of the tile transforms δx = ω_o × x + v_o,
-    /// the energy changes by Σ_o ω_o·M_o + v_o·F_o at fixed dofs (`03-homogenization.md`, section 5; used for the
+    /// the energy changes by Σ_o ω_o·M_o + v_o·F_o at fixed dofs (`docs/micro-solver.md`, section 5; used for the
     /// envelope-theorem stress).
     pub fn offset_resultants(
         &self,

@@ -1,5 +1,5 @@
 //! Calibration of the yarn parameters against patterns that should be static equilibria
-//! (`06-verification.md` item b, `02-yarn-model.md` "What the original reference patterns tell").
+//! (`docs/derivative-harness.md` item b, `docs/yarn-model.md` "What the original reference patterns tell").
 //!
 //! At a pattern's stored state the energy gradient is linear in the stiffness parameters:
 //!
@@ -7,7 +7,7 @@
 //!
 //! with a_s, a_b, a_t, a_c the gradients of the stretching, bending, twisting and contact terms per unit parameter
 //! (the contact term for a given quadrature order, exclusion and radius). Angles enter as r·θ (the unit scaling of
-//! `03-homogenization.md`), so every entry is a force. The overall scale is free (Y = 1e6 Pa fixes it); the best
+//! `docs/micro-solver.md`), so every entry is a force. The overall scale is free (Y = 1e6 Pa fixes it); the best
 //! (γY, γG, k_c) ≥ 0 for one pattern or a set of patterns is a small non-negative linear least-squares problem.
 //!
 //! Residual reported: ‖∇E‖ / ‖∇E_rods‖ with ‖∇E_rods‖ = (‖Y a_s‖² + ‖γY a_b‖² + ‖γG a_t‖²)^½, the size of the rod

@@ -1,4 +1,4 @@
-//! The fuzz suite (docs/robustness.md; `../shared/design/06-verification.md`, robustness): mutated inputs of the five input
+//! The fuzz suite (docs/robustness.md; `docs/robustness.md`, robustness): mutated inputs of the five input
 //! formats — `.pyp` patterns, material JSON, sampling plans, scene JSON and sample files — through the library's
 //! parsers and, where a mutant parses, its evaluators, in process.
 //!

@@ -1,4 +1,4 @@
-//! Verification and validation against the original method's data (`../shared/design/06-verification.md`,
+//! Verification and validation against the original method's data (`docs/derivative-harness.md`,
 //! section 3), kept out of the numerical core: the stages below know nothing of it.
 //!
 //! - [`conformance`]: ψ and the strain chain against the original code's oracle vectors (item 3a);

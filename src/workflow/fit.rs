@@ -1,4 +1,4 @@
-//! A material from a sample file (Algorithm C5; `04-sampling-fitting.md`, "Fitting (C5, C6, C7)"), with the
+//! A material from a sample file (Algorithm C5; `docs/sampling.md`, "Fitting (C5, C6, C7)"), with the
 //! material JSON, the JSON fit report and the PNG plots written, and the per-term error table reported.
 
 use super::inputs::load_plan;

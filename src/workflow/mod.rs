@@ -1,5 +1,5 @@
 //! Workflows: the stages of `../shared/seed/hylc_pseudocode.txt` put together the way the command line runs them
-//! (`../shared/design/01-architecture.md`, "Command line"), as library functions that the `hylc` binary, the
+//! (`docs/layout.md`, "Command line"), as library functions that the `hylc` binary, the
 //! tests and the Python module share:
 //!
 //! - [`inputs`]: a pattern, a construction or a sampling plan from a command-line style argument;

@@ -1,4 +1,4 @@
-//! The main job end to end (`../shared/design/01-architecture.md`, "Command line"; the pipeline of
+//! The main job end to end (`docs/layout.md`, "Command line"; the pipeline of
 //! `../shared/seed/hylc_pseudocode.txt`, C1 → C4 → C5–C7 → C8). For each pattern: generate it, compute its
 //! reference state (C1), run a sampling plan and a small held-out in-plane grid (C4), fit the material
 //! (C5–C7), and drape a cloth with it (C8); report a per-stage summary and write everything to one folder.

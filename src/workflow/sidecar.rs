@@ -1,6 +1,6 @@
 //! The sidecar of a sample file (`samples.jsonl` → `samples.meta.json`): the plan, the pattern (its `.pyp` text),
 //! the yarn parameters, the solver settings, the problem hash and the pattern's areal density, which the fit reads
-//! (`04-sampling-fitting.md`, "Sampling plan (C4)").
+//! (`docs/sampling.md`, "Sampling plan (C4)").
 
 use super::{write_file, WorkflowError};
 use crate::micro::MicroProblem;

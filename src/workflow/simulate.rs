@@ -1,4 +1,4 @@
-//! A cloth scene (Algorithm C8; `05-macro.md`, `crate::shell::scene`) with command-line style overrides: its
+//! A cloth scene (Algorithm C8; `docs/cloth-simulator.md`, `crate::shell::scene`) with command-line style overrides: its
 //! frames (`frame_NNNN.obj`), its step log (`log.jsonl`) and a PNG snapshot of the final state.
 
 use super::{Event, WorkflowError};

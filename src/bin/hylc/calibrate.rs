@@ -1,5 +1,5 @@
 //! `hylc calibrate`: the yarn-parameter calibration against the original reference patterns
-//! (`06-verification.md` item b; `hylc::validation::calibration`).
+//! (`docs/derivative-harness.md` item b; `hylc::validation::calibration`).
 
 use crate::args::{parse_list, OutputArgs};
 use anyhow::anyhow;

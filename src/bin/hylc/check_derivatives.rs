@@ -1,5 +1,5 @@
 //! `hylc check-derivatives`: the derivative harness (`hylc::diff`) on every registered function
-//! (`hylc::checks`; `../shared/design/06-verification.md`).
+//! (`hylc::checks`; `docs/derivative-harness.md`).
 
 use hylc::checks::run_all;
 use hylc::diff::{format_table, CheckConfig};

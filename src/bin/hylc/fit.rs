@@ -1,4 +1,4 @@
-//! `hylc fit SAMPLES`: a material from a sample file (Algorithm C5; `04-sampling-fitting.md`, "Fitting (C5, C6,
+//! `hylc fit SAMPLES`: a material from a sample file (Algorithm C5; `docs/sampling.md`, "Fitting (C5, C6,
 //! C7)"; `hylc::workflow::fit`), with the JSON fit report and PNG plots.
 
 use crate::printer::Printer;

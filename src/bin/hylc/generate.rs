@@ -1,4 +1,4 @@
-//! `hylc generate KIND`: a yarn pattern made procedurally (`hylc::generate`; `02-yarn-model.md`).
+//! `hylc generate KIND`: a yarn pattern made procedurally (`hylc::generate`; `docs/yarn-model.md`).
 
 use anyhow::anyhow;
 use hylc::generate::{generate_kind, min_centerline_distance, to_obj, SameYarn};

@@ -1,4 +1,4 @@
-//! The `hylc` command line (`../shared/design/01-architecture.md`, "Command line"): one module per subcommand,
+//! The `hylc` command line (`docs/layout.md`, "Command line"): one module per subcommand,
 //! each with its `clap` arguments and a `run` function; the work itself is in the library (`hylc::workflow` and
 //! the stages below it). Errors become one line on stderr and exit code 2.
 

@@ -1,4 +1,4 @@
-//! `hylc material FILE --z …`: ψ, ∇ψ, ∇²ψ of a material (`hylc::material`; `05-macro.md`).
+//! `hylc material FILE --z …`: ψ, ∇ψ, ∇²ψ of a material (`hylc::material`; `docs/material.md`).
 
 use anyhow::anyhow;
 use hylc::material::synthetic::default_material;

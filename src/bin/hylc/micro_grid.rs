@@ -1,5 +1,5 @@
 //! `hylc micro-grid`: our micro solver against the original solver's displacements on the 9×9×9 in-plane grid
-//! (`../shared/design/06-verification.md`, item 3c; `hylc::validation::grid`).
+//! (`docs/derivative-harness.md`, item 3c; `hylc::validation::grid`).
 
 use crate::args::{exit, SolverArgs, YarnArgs};
 use crate::strain::load_pattern_noted;
@@ -164,7 +164,7 @@ fn write_json(
     };
     root["about"] = serde_json::json!(
         "hylc micro-grid: our micro solver against the original solver's displacements on the 9x9x9 in-plane \
-         grid (06-verification.md, item 3c). Position errors in units of the yarn radius r, θ errors in rad, both \
+         grid (docs/derivative-harness.md, item 3c). Position errors in units of the yarn radius r, θ errors in rad, both \
          relative to each side's z = 0 state; times in s."
     );
     let stem = Path::new(pattern)

@@ -1,4 +1,4 @@
-//! `hylc pattern FILE`: load and check a `.pyp` yarn pattern (`hylc::pattern`; `02-yarn-model.md`).
+//! `hylc pattern FILE`: load and check a `.pyp` yarn pattern (`hylc::pattern`; `docs/yarn-model.md`).
 
 use hylc::pattern::Pattern;
 use std::path::PathBuf;

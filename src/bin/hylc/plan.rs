@@ -1,4 +1,4 @@
-//! `hylc plan --write FILE`: a built-in sampling plan as JSON (`04-sampling-fitting.md`, "Sampling plan (C4)").
+//! `hylc plan --write FILE`: a built-in sampling plan as JSON (`docs/sampling.md`, "Sampling plan (C4)").
 
 use anyhow::anyhow;
 use hylc::sample::Plan;

@@ -1,4 +1,4 @@
-//! `hylc reference PATTERN --out REF.pyp`: Algorithm C1 on a pattern (`03-homogenization.md`, section 6;
+//! `hylc reference PATTERN --out REF.pyp`: Algorithm C1 on a pattern (`docs/micro-solver.md`, section 6;
 //! `hylc::micro::reference`), written as `.pyp`.
 
 use crate::args::{ConstructionArg, OutputArgs, YarnArgs};

@@ -1,5 +1,5 @@
 //! `hylc sample PATTERN --plan P --out S.jsonl`: a sampling plan on one pattern
-//! (`04-sampling-fitting.md`, section "Sampling plan (C4)"; `hylc::sample`).
+//! (`docs/sampling.md`, section "Sampling plan (C4)"; `hylc::sample`).
 
 use crate::args::{exit, PredictorArg, SolverArgs, YarnArgs};
 use crate::printer::sample_bar;

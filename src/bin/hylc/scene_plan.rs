@@ -1,5 +1,5 @@
 //! `hylc scene-plan LOG... --write PLAN`: a sampling plan covering only what one or more cloth runs visited
-//! (`05-macro.md`, "model only what a scene requires"; `hylc::sample::scene`).
+//! (`docs/cloth-simulator.md`, "model only what a scene requires"; `hylc::sample::scene`).
 
 use anyhow::anyhow;
 use hylc::sample::scene::{scene_plan, StrainExtent};

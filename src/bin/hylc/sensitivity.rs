@@ -1,5 +1,5 @@
 //! `hylc sensitivity PATTERN --z …`: Ψ̄ and its derivatives with respect to the strain and the yarn parameters
-//! at one strain (envelope theorem; `03-homogenization.md`, `hylc::micro::envelope`), and the equilibrium's
+//! at one strain (envelope theorem; `docs/micro-solver.md`, `hylc::micro::envelope`), and the equilibrium's
 //! sensitivity to each yarn parameter (`hylc::micro::sensitivity`, docs/yarn-parameters.md).
 
 use crate::args::YarnArgs;

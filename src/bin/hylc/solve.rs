@@ -1,4 +1,4 @@
-//! `hylc solve PATTERN --z …`: the micro solver on one pattern at one or more strains (`03-homogenization.md`;
+//! `hylc solve PATTERN --z …`: the micro solver on one pattern at one or more strains (`docs/micro-solver.md`;
 //! `hylc::micro`).
 
 use crate::args::{exit, PredictorArg, SolverArgs, YarnArgs};

@@ -1,4 +1,4 @@
-//! Step 7′ of FIT2D (`04-sampling-fitting.md`, "Fitting (C5, C6, C7)", FIT2D step 7; the option
+//! Step 7′ of FIT2D (`docs/fitting.md`, "Fitting (C5, C6, C7)", FIT2D step 7; the option
 //! `hylc fit --compression-residual`): instead of zeroing the residual on the compressed half-plane of a stretch
 //! axis, keep it there as a non-negative excess that is monotone outward from the axes.
 //!

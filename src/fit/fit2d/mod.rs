@@ -1,4 +1,4 @@
-//! FIT2D (`04-sampling-fitting.md`, "Fitting (C5, C6, C7)", FIT2D steps 1–7, and a step 8 of ours): one 2D term f_kl of the material
+//! FIT2D (`docs/fitting.md`, "Fitting (C5, C6, C7)", FIT2D steps 1–7, and a step 8 of ours): one 2D term f_kl of the material
 //! from samples (X, Y, Ψ) of its 2D grid (X, Y already normalised by the strain scales).
 //!
 //! 1. g(u, v) = symexp(MLS(u, v | X, Y, symlog Ψ)) with a 2D local-quadratic MLS ([`Mls2D`]), symmetrised in the

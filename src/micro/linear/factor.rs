@@ -1,4 +1,4 @@
-//! The factorisations of K = H + μI behind the KKT solve (`03-homogenization.md`, section 3).
+//! The factorisations of K = H + μI behind the KKT solve (`docs/micro-solver.md`, section 3).
 //!
 //! - [`Factorization::Cholesky`] (the default): sparse LLᵀ; it exists only when K is positive definite.
 //! - [`Factorization::Inertia`]: sparse LDLᵀ without pivoting, accepted when the KKT matrix

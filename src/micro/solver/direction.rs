@@ -1,4 +1,4 @@
-//! The Newton direction of one micro-solver iteration (`03-homogenization.md`, sections 3–4, step 3): the KKT
+//! The Newton direction of one micro-solver iteration (`docs/micro-solver.md`, sections 3–4, step 3): the KKT
 //! step with the regularisation μ grown ×10 until it exists (the design's rule), and the exact constrained step of
 //! [`StepRule::Inertia`] tried first.
 

@@ -1,4 +1,4 @@
-//! The step of one Newton iteration of the micro solver (`03-homogenization.md`, section 4, steps 4–5): the exact
+//! The step of one Newton iteration of the micro solver (`docs/micro-solver.md`, section 4, steps 4–5): the exact
 //! step of [`StepRule::Inertia`] and the backtracking line search, both with their yarn-crossing check
 //! ([`SolverOptions::crossings`]).
 

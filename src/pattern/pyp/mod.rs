@@ -1,5 +1,5 @@
 //! Reading and writing `.pyp` pattern files, and the consistency checks of a [`Pattern`]
-//! (`../shared/design/02-yarn-model.md`, "Periodic yarn pattern" and its `.pyp` table).
+//! (`docs/yarn-model.md`, "Periodic yarn pattern" and its `.pyp` table).
 //!
 //! # Format
 //!
@@ -43,7 +43,7 @@
 //!   s = (l − l̄)/l̄ of every edge (l its current length), the pattern is flagged when a periodic edge's strain lies
 //!   more than [`PERIOD_MISMATCH_TOL`] = 1 % outside the range of the interior edges' strains (or outside ±1 % if
 //!   there are no interior edges). Of the originals only basket is flagged (its periodic edges are 6.6–9.4 %
-//!   short, its interior edges within 0.07 %; `02-yarn-model.md`); in the other four the periodic edges' strains
+//!   short, its interior edges within 0.07 %; `docs/yarn-model.md`); in the other four the periodic edges' strains
 //!   lie within 0.004 % of their interior range.
 
 mod checks;

@@ -1,4 +1,4 @@
-//! Checking a sampling plan (`../shared/design/04-sampling-fitting.md`, "Sampling plan (C4)"; docs/robustness.md): the
+//! Checking a sampling plan (`docs/sampling.md`, "Sampling plan (C4)"; docs/robustness.md): the
 //! admissible strains and sizes of a plan, [`Plan::validate`], and reading plan JSON with errors that name the
 //! file and field ([`Plan::from_json`], [`Plan::load`]).
 
@@ -169,7 +169,7 @@ impl Plan {
 
     /// Check ranges, counts and pairs: every range value and grid value admissible ([`inadmissible`]: stretches in
     /// [[`MIN_PLAN_STRETCH`], [`MAX_PLAN_STRETCH`]], |s_a| < [`MAX_PLAN_SHEAR`], |Π| ≤ [`MAX_PLAN_CURVATURE`]), every count and the
-    /// total at most [`MAX_PLAN_SAMPLES`] (`04-sampling-fitting.md`, "Sampling plan (C4)"). Every runner and
+    /// total at most [`MAX_PLAN_SAMPLES`] (`docs/sampling.md`, "Sampling plan (C4)"). Every runner and
     /// [`Plan::from_json`] call this before enumerating a sample.
     pub fn validate(&self) -> Result<(), PlanError> {
         let err = |field: String, message: String| PlanError {

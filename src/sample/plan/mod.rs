@@ -1,4 +1,4 @@
-//! Sampling plans (`../shared/design/04-sampling-fitting.md`, section "Sampling plan (C4)").
+//! Sampling plans (`docs/sampling.md`, section "Sampling plan (C4)").
 //!
 //! A [`Plan`] lists per-strain ranges, the sample counts of the 1D ranges and of the 2D grids, and the strain
 //! pairs of the grids. Its samples are enumerated in a fixed order (the five 1D ranges, then the grids row-major),
@@ -83,7 +83,7 @@ impl Default for Ranges {
     }
 }
 
-/// A sampling plan (`04-sampling-fitting.md`, "Sampling plan (C4)"), stored as JSON.
+/// A sampling plan (`docs/sampling.md`, "Sampling plan (C4)"), stored as JSON.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Plan {
@@ -101,7 +101,7 @@ pub struct Plan {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ranges_2d: Option<Vec<[[f64; 2]; 2]>>,
     /// An optional tensor grid of in-plane strains (s_x, s_a, s_y all varying, no bending): held-out samples
-    /// off the sampled planes, which the additive model must predict (`04-sampling-fitting.md`, "Quality
+    /// off the sampled planes, which the additive model must predict (`docs/sampling.md`, "Quality
     /// report"). Absent from the JSON (and from the hash) when `None`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub grid: Option<InPlaneGrid>,
@@ -124,7 +124,7 @@ pub struct InPlaneGrid {
 }
 
 impl InPlaneGrid {
-    /// The 9×9×9 grid of the original displacement data (`06-verification.md`, item 3c): s_x, s_y ∈ {−0.2, −0.1,
+    /// The 9×9×9 grid of the original displacement data (`docs/derivative-harness.md`, item 3c): s_x, s_y ∈ {−0.2, −0.1,
     /// 0, 1/6, …, 1}, s_a ∈ {−0.7, −0.525, …, 0.7}.
     pub fn original() -> Self {
         let stretch: Vec<f64> = [-0.2, -0.1]

@@ -1,4 +1,4 @@
-//! The built-in scenes (`05-macro.md`, "built-ins reproduce the original's tests").
+//! The built-in scenes (`docs/cloth-simulator.md`, "built-ins reproduce the original's tests").
 
 use super::*;
 

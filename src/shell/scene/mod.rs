@@ -1,4 +1,4 @@
-//! Scenes (`05-macro.md`, "Scenes are JSON files; built-ins reproduce the original's tests"): the JSON format,
+//! Scenes (`docs/cloth-simulator.md`, "Scenes are JSON files; built-ins reproduce the original's tests"): the JSON format,
 //! the built-in scenes, and the runner that writes an OBJ per frame and a JSON-lines log per step.
 //!
 //! Format (unknown keys are errors; every key but `material`, `mesh` and `duration` has a default):

@@ -1,4 +1,4 @@
-//! The Newton system of a step (`05-macro.md`, "The cloth solver"): the exact Hessian first, the PSD option's
+//! The Newton system of a step (`docs/cloth-simulator.md`, "The cloth solver"): the exact Hessian first, the PSD option's
 //! Hessian when it is not positive definite, a growing diagonal shift as the last resort; faer's sparse
 //! Cholesky with the simulation's symbolic analysis, numeric factorisation and solve run sequentially (on this
 //! 2-core machine faer's parallel supernodal factorisation spent more time handing work between threads than it

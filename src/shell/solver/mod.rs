@@ -1,4 +1,4 @@
-//! The cloth solver (`05-macro.md`, "The cloth solver"; docs/cloth-simulator.md): implicit Euler as minimisation of the
+//! The cloth solver (`docs/cloth-simulator.md`, "The cloth solver"; docs/cloth-simulator.md): implicit Euler as minimisation of the
 //! incremental potential, adaptive substeps, and a quasi-static mode.
 //!
 //! Per (sub)step of length h, with x̃ = xₙ + h vₙ, the free dofs minimise
@@ -11,7 +11,7 @@
 //! tolerance. The sparse Hessian (free dofs only, the lower triangle in the pattern of
 //! [`assemble`](super::assemble)) is factorised by faer's sparse Cholesky with the symbolic analysis computed
 //! once per simulation ([`linear`]). With `exact_first` (default) the exact Hessian is factorised first and the
-//! PSD option's Hessian (`05-macro.md`, options (a)–(c)) used only when that fails (not positive definite):
+//! PSD option's Hessian (`docs/cloth-simulator.md`, options (a)–(c)) used only when that fails (not positive definite):
 //! projected Newton far from the solution, Newton's quadratic convergence near it. If the numeric factorisation
 //! of the projected Hessian fails (an indefinite matrix, possible with [`Psd::None`](super::Psd) or in
 //! quasi-static mode) a diagonal shift μ I is added and increased tenfold until it succeeds.

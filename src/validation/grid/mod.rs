@@ -1,4 +1,4 @@
-//! Validation item 3c (`../shared/design/06-verification.md`, section 3c): our micro solver against the original
+//! Validation item 3c (`docs/derivative-harness.md`, section 3c): our micro solver against the original
 //! solver's equilibrium displacements on the 9×9×9 in-plane strain grid of `../shared/data/hylc2020/displacements/`.
 //!
 //! Data ([`GridData`]): `axes.txt` lists the nine s_x, s_a and s_y values (one line each); `data.npy` is float32 of
@@ -6,7 +6,7 @@
 //! (dξ₁, dξ₂, dh) mapped back to reference coordinates and dθ.
 //!
 //! Our counterpart ([`counterpart`]) at an in-plane strain is (F₂⁻¹ ũ_xy, ũ_z, θ − θ_ref), with F₂ the upper 2×2
-//! block of F = [[a, bc], [0, b√(1−c²)]] (`03-homogenization.md`, section 1) and ũ the world displacement from
+//! block of F = [[a, bc], [0, b√(1−c²)]] (`docs/micro-solver.md`, section 1) and ũ the world displacement from
 //! φ(ξ_v) + h_v n. Both sides are compared relative to their own z = 0 state.
 //!
 //! The grid is solved by warm-started continuation ([`run_grid`]): a cold solve at the grid point nearest z = 0,
@@ -274,7 +274,7 @@ impl GridData {
 }
 
 /// Our counterpart of the original displacement rows for a state at an in-plane strain: per vertex
-/// (F₂⁻¹ ũ_xy, ũ_z, θ − θ_ref) (`06-verification.md`, 3c), with ũ the world displacement from φ(ξ_v) + h_v n.
+/// (F₂⁻¹ ũ_xy, ũ_z, θ − θ_ref) (`docs/derivative-harness.md`, 3c), with ũ the world displacement from φ(ξ_v) + h_v n.
 /// `None` for a bending strain (the original grid is in-plane only).
 pub fn counterpart(pattern: &Pattern, state: &MicroState) -> Option<Vec<[f64; 4]>> {
     let z = state.strain.0;
