@@ -2,6 +2,8 @@
 //! smoothstep, every pin and handle reports its reaction under its name (in the log and in
 //! `handle_forces.csv`), and obstacles move with their motion (penalty and friction relative to the obstacle).
 
+mod common;
+
 use hylc::material::synthetic::default_material;
 use hylc::shell::motion::Motion;
 use hylc::shell::scene::{self, MeshSpec, ObstacleSpec, Placement, Scene};
@@ -9,19 +11,7 @@ use hylc::shell::solver::{Boundary, Settings, Simulation};
 use hylc::shell::{ElementModel, Mesh, ModelFlags, Psd};
 use std::path::Path;
 
-/// A coarse built-in scene (edge `edge`, `duration` s).
-fn coarse(name: &str, edge: f64, duration: f64) -> Scene {
-    let mut s = scene::builtin(name).unwrap();
-    s.mesh = MeshSpec::Rectangle {
-        width: scene::SIDE,
-        height: scene::SIDE,
-        edge,
-        perturb: 0.0,
-        seed: 1,
-    };
-    s.duration = duration;
-    s
-}
+use common::coarse_builtin as coarse;
 
 fn total_mass(sim: &Simulation) -> f64 {
     sim.mass.iter().sum()

@@ -2,22 +2,12 @@
 //! error (exactly h² |g|/2 in free fall), `solver.time_tol` keeps every accepted substep within it, and a tighter
 //! tolerance follows a reference run with tiny steps more closely.
 
-use hylc::shell::scene::{self, MeshSpec, Scene};
+mod common;
+
+use hylc::shell::scene::Scene;
 use std::path::Path;
 
-/// A coarse built-in scene (edge `edge`, `duration` s).
-fn coarse(name: &str, edge: f64, duration: f64) -> Scene {
-    let mut s = scene::builtin(name).unwrap();
-    s.mesh = MeshSpec::Rectangle {
-        width: scene::SIDE,
-        height: scene::SIDE,
-        edge,
-        perturb: 0.0,
-        seed: 1,
-    };
-    s.duration = duration;
-    s
-}
+use common::coarse_builtin as coarse;
 
 fn reports(s: &Scene) -> Vec<hylc::shell::solver::StepReport> {
     let (mut sim, _) = s.build("scene.json", Path::new(".")).unwrap();

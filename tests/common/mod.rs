@@ -43,3 +43,17 @@ pub fn cli_error(args: &[&str]) -> String {
     assert_eq!(err.lines().count(), 1, "{err}");
     err
 }
+
+/// A built-in scene on a coarse rectangle mesh of edge `edge` (m), simulated for `duration` (s).
+pub fn coarse_builtin(name: &str, edge: f64, duration: f64) -> hylc::shell::scene::Scene {
+    let mut s = hylc::shell::scene::builtin(name).unwrap();
+    s.mesh = hylc::shell::scene::MeshSpec::Rectangle {
+        width: hylc::shell::scene::SIDE,
+        height: hylc::shell::scene::SIDE,
+        edge,
+        perturb: 0.0,
+        seed: 1,
+    };
+    s.duration = duration;
+    s
+}
