@@ -5,7 +5,7 @@
 //! ≤ 1e-5. Also the cost of one gradient against one Newton iteration of the forward solve (printed).
 
 use hylc::material::coefficients::Coefficient;
-use hylc::shell::scene::{self, MeshSpec, Scene};
+use hylc::shell::scene::{self, MeshSpec, ObstacleSpec, Scene};
 use hylc::shell::solver::{Observable, Sensitivity, Simulation};
 use hylc::shell::ShellError;
 use std::path::Path;
@@ -56,6 +56,17 @@ enum Param {
     Mass,
     Gravity(usize),
     Coef(Coefficient),
+    /// component `axis` of the offset of keyframe `key` of the scene's handle number `handle`
+    Keyframe {
+        handle: usize,
+        key: usize,
+        axis: usize,
+    },
+    /// component `axis` of the position of the scene's obstacle number `index` (a sphere's centre)
+    Obstacle {
+        index: usize,
+        axis: usize,
+    },
 }
 
 /// The equilibrium of `case` with parameter `p` shifted by `d`.
@@ -67,6 +78,11 @@ fn solve(case: &Case, p: Param, d: f64) -> Simulation {
         Param::Mass => s.model.mass += d,
         Param::Gravity(c) => s.gravity[c] += d,
         Param::Coef(_) => {}
+        Param::Keyframe { handle, key, axis } => s.handles[handle].keyframes[key].offset[axis] += d,
+        Param::Obstacle { index, axis } => match &mut s.obstacles[index] {
+            ObstacleSpec::Sphere { center, .. } => center[axis] += d,
+            _ => unreachable!("the tests move spheres only"),
+        },
     }
     let (mut sim, _) = s.build("scene.json", Path::new(".")).unwrap();
     if let Param::Coef(c) = p {
@@ -99,6 +115,15 @@ fn base_and_adjoint(s: &Scene, sim: &Simulation, sens: &Sensitivity, p: Param) -
             sim.model.material.coefficient(c),
             sens.material.as_ref().unwrap().get(c),
         ),
+        Param::Keyframe { handle, key, axis } => {
+            let h = &s.handles[handle];
+            let g = sens.held.iter().find(|g| g.name == h.name).unwrap();
+            (h.keyframes[key].offset[axis], g.keyframes[key][axis])
+        }
+        Param::Obstacle { index, axis } => match &s.obstacles[index] {
+            ObstacleSpec::Sphere { center, .. } => (center[axis], sens.obstacles[index][axis]),
+            _ => unreachable!("the tests move spheres only"),
+        },
     }
 }
 
@@ -161,9 +186,15 @@ fn sample_coefficients(sim: &Simulation, sens: &Sensitivity) -> Vec<Coefficient>
 }
 
 /// Compare the adjoint's derivatives of `observables` at the equilibrium of `s` against central differences of
-/// re-solves for the scene scalars and a sample of coefficients (chosen with the first observable); returns the
-/// worst relative error.
-fn compare(name: &str, case: &Case, observables: &[Observable], coefficients: bool) -> f64 {
+/// re-solves for the scene scalars, `extra` parameters and a sample of coefficients (chosen with the first
+/// observable); returns the worst relative error.
+fn compare(
+    name: &str,
+    case: &Case,
+    observables: &[Observable],
+    coefficients: bool,
+    extra: &[Param],
+) -> f64 {
     let s = &case.scene;
     let base = solve(case, Param::Stiffness, 0.0);
     let sens: Vec<Sensitivity> = observables
@@ -178,6 +209,7 @@ fn compare(name: &str, case: &Case, observables: &[Observable], coefficients: bo
         Param::Gravity(1),
         Param::Gravity(2),
     ];
+    params.extend_from_slice(extra);
     if coefficients {
         let coefs = sample_coefficients(&base, &sens[0]);
         println!("{name}: {} coefficients sampled", coefs.len());
@@ -192,6 +224,9 @@ fn compare(name: &str, case: &Case, observables: &[Observable], coefficients: bo
             Param::Gravity(_) => 9.81,
             // a coefficient by at least the mean size of its array's (a knot value may be 0)
             Param::Coef(c) => coefficient_scale(&base, c),
+            // positions in metres: by at least the pull and the sphere's radius
+            Param::Keyframe { .. } => 2e-2,
+            Param::Obstacle { .. } => 3e-2,
             _ => 1e-2,
         };
         v.abs().max(floor)
@@ -210,7 +245,13 @@ fn compare(name: &str, case: &Case, observables: &[Observable], coefficients: bo
     let mut compared = 0;
     for &p in &params {
         let pm = magnitude(p);
-        let h = 1e-5 * pm;
+        // the obstacle penalty's curvature changes over the contact's penetration depth (micrometres, where the
+        // penalty's third derivative jumps): a step of 1e-5 × 3 cm = 0.3 µm is not small against it, and the
+        // difference carries a truncation error of 1e-5 relative; 3 nm is
+        let h = match p {
+            Param::Obstacle { .. } => 1e-7 * pm,
+            _ => 1e-5 * pm,
+        };
         let plus = solve(case, p, h);
         let minus = solve(case, p, -h);
         for (k, o) in observables.iter().enumerate() {
@@ -246,7 +287,7 @@ fn compare(name: &str, case: &Case, observables: &[Observable], coefficients: bo
         "{name}: {compared} derivatives compared, worst relative error {worst:.2e}; the small ones: worst error \
          relative to the observable's scale {worst_small:.2e}"
     );
-    assert!(compared >= if coefficients { 3 * 15 } else { 6 });
+    assert!(compared >= if coefficients { 3 * 15 } else { 6 } + extra.len());
     worst
 }
 
@@ -309,7 +350,7 @@ fn hanging_sensitivities_match_resolves() {
         1e3 * full,
         full / newton
     );
-    compare("hanging", &s, &obs, true);
+    compare("hanging", &s, &obs, true, &[]);
 }
 
 #[test]
@@ -325,7 +366,7 @@ fn stretch_sensitivities_match_resolves() {
         Observable::ElasticEnergy,
         target(&base),
     ];
-    compare("stretch-x", &s, &obs, true);
+    compare("stretch-x", &s, &obs, true, &[]);
 }
 
 #[test]
@@ -347,7 +388,7 @@ fn drape_sensitivities_match_resolves() {
         }
         Err(e) => panic!("{e}"),
         Ok(_) => {
-            compare("drape-x", &s, &obs, true);
+            compare("drape-x", &s, &obs, true, &[]);
         }
     }
 }
@@ -371,7 +412,43 @@ fn spring_handle_sensitivities_match_resolves() {
         Observable::CenterOfMass { axis: 2 },
         target(&base),
     ];
-    compare("stretch-x springs", &s, &obs, false);
+    compare("stretch-x springs", &s, &obs, false, &keyframes());
+}
+
+/// Keyframe offsets of the stretch's two handles (`left`, `right`): both keyframes along the pull, the last one
+/// across it.
+fn keyframes() -> Vec<Param> {
+    let k = |handle, key, axis| Param::Keyframe { handle, key, axis };
+    vec![k(1, 1, 0), k(0, 1, 0), k(1, 0, 0), k(1, 1, 2), k(0, 1, 1)]
+}
+
+/// Halfway through the pull (both keyframes weigh in) over a sphere that lifts the sheet's middle by 5 mm: the
+/// handles' keyframe offsets and the sphere's position, hard constraints.
+#[test]
+fn boundary_sensitivities_match_resolves() {
+    let mut s = coarse("stretch-x", 0.3 / 16.0, 0.15, 0.05, 0.0);
+    s.scene.obstacles = vec![ObstacleSpec::Sphere {
+        center: [0.16, 0.14, -0.025],
+        radius: 0.03,
+        motion: None,
+    }];
+    let base = solve(&s, Param::Stiffness, 0.0);
+    let obs = vec![
+        Observable::Reaction {
+            set: "right".into(),
+            axis: 0,
+        },
+        Observable::CenterOfMass { axis: 2 },
+        Observable::ElasticEnergy,
+        Observable::Reaction {
+            set: "left".into(),
+            axis: 2,
+        },
+        target(&base),
+    ];
+    let mut extra = keyframes();
+    extra.extend((0..3).map(|axis| Param::Obstacle { index: 0, axis }));
+    compare("stretch-x over a sphere", &s, &obs, false, &extra);
 }
 
 /// The typed errors: the flat hanging equilibrium (reached from a flat start) is a saddle, its top compressed

@@ -261,6 +261,49 @@ impl Motion {
         }
     }
 
+    /// The weights wᵢ(t) of the keyframe offsets in the translation: x(t) = Σᵢ wᵢ(t) oᵢ + (the explicit
+    /// velocities' part), the same weight for each component. Linear: 1 − s and s on the interval's ends.
+    /// Hermite: h₀₀ and h₀₁ on the ends, and each end's h₁₀ h or h₁₁ h times its velocity's weights when that
+    /// velocity is ARCSim's central difference (oⱼ₊₁ − oⱼ₋₁)/(tⱼ₊₁ − tⱼ₋₁); an explicit or end velocity carries
+    /// no offset. Outside the keyframes, 1 on the keyframe held. dx(t)/doᵢ = wᵢ(t) (the sensitivities to a
+    /// handle's keyframes, `shell::solver::Sensitivity`).
+    pub fn offset_weights(&self, t: f64) -> Vec<f64> {
+        let k = &self.keyframes;
+        let mut w = vec![0.0; k.len()];
+        let Some(i) = self.interval(t) else {
+            if let Some(first) = k.first() {
+                let j = if t.is_nan() || t <= first.time {
+                    0
+                } else {
+                    k.len() - 1
+                };
+                w[j] = 1.0;
+            }
+            return w;
+        };
+        let h = k[i + 1].time - k[i].time;
+        let s = (t - k[i].time) / h;
+        match self.interpolation {
+            Interpolation::Linear => {
+                w[i] = 1.0 - s;
+                w[i + 1] = s;
+            }
+            Interpolation::Hermite => {
+                let (s2, s3) = (s * s, s * s * s);
+                w[i] += 2.0 * s3 - 3.0 * s2 + 1.0;
+                w[i + 1] += -2.0 * s3 + 3.0 * s2;
+                for (j, c) in [(i, (s3 - 2.0 * s2 + s) * h), (i + 1, (s3 - s2) * h)] {
+                    if k[j].velocity.is_none() && j > 0 && j + 1 < k.len() {
+                        let dt = k[j + 1].time - k[j - 1].time;
+                        w[j + 1] += c / dt;
+                        w[j - 1] -= c / dt;
+                    }
+                }
+            }
+        }
+        w
+    }
+
     /// The velocity ẋ(t) (m/s).
     pub fn velocity(&self, t: f64) -> [f64; 3] {
         let Some(i) = self.interval(t) else {
@@ -349,6 +392,38 @@ mod tests {
         // a velocity on a linear motion is refused
         m.interpolation = Interpolation::Linear;
         assert_eq!(m.check(), Err(MotionError::LinearVelocity { index: 0 }));
+    }
+
+    /// The translation is affine in the keyframe offsets with the weights of `offset_weights`: moving keyframe i
+    /// by δ moves x(t) by wᵢ(t) δ, for linear and Hermite motions (one velocity explicit), inside and outside
+    /// the keyframes.
+    #[test]
+    fn offset_weights_are_the_derivative_of_position() {
+        let keys = [
+            (0.0, [0.0, 0.1, 0.0]),
+            (0.3, [0.5, 0.0, -0.2]),
+            (0.7, [0.2, 0.4, 0.1]),
+            (1.0, [1.0, 0.0, 0.3]),
+        ];
+        let mut explicit = Motion::hermite(&keys);
+        explicit.keyframes[2].velocity = Some([0.3, -1.0, 2.0]);
+        for m in [Motion::linear(&keys), Motion::hermite(&keys), explicit] {
+            for t in [-0.5, 0.0, 0.1, 0.3, 0.45, 0.69, 0.85, 1.0, 3.0] {
+                let w = m.offset_weights(t);
+                assert_eq!(w.len(), keys.len());
+                for i in 0..keys.len() {
+                    let mut moved = m.clone();
+                    moved.keyframes[i].offset[1] += 1.0;
+                    let (a, b) = (m.position(t), moved.position(t));
+                    assert!(
+                        (b[1] - a[1] - w[i]).abs() < 1e-12,
+                        "t {t} keyframe {i}: {w:?}"
+                    );
+                    assert!((b[0] - a[0]).abs() < 1e-15 && (b[2] - a[2]).abs() < 1e-15);
+                }
+            }
+        }
+        assert!(Motion::fixed().offset_weights(0.5).is_empty());
     }
 
     /// Before the first keyframe at the first translation, after the last at the last, at rest; no keyframe:

@@ -66,7 +66,7 @@ mod terms;
 
 pub use stepping::strain_quantile;
 
-pub use adjoint::{Observable, Sensitivity};
+pub use adjoint::{HeldGradient, Observable, Sensitivity};
 pub use integrator::{bdf2_coefficients, Integrator};
 use integrator::{Anchor, History};
 

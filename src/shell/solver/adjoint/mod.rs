@@ -21,6 +21,8 @@
 //!   dJ/d(model.mass) = dJ/dμ / model.mass, [`Sensitivity::mass_multiplier`]): gravity −m g and the obstacle
 //!   penalty m k p³/3 are linear in m, so ∂g/∂μ is their gradient;
 //! - gravity: ∂g_v/∂g_c = −m_v e_c;
+//! - the positions of the boundary: every held set's translation and keyframe offsets, every obstacle's
+//!   translation (`boundary`);
 //! - every coefficient c_j of the model's material (`material::coefficients`): ∂g/∂c_j = Σ_Δ A s Jᵀ S ∇φ_j(S z).
 //!   Reverse mode: per triangle w = A s S J λ_Δ (the adjoint pulled back to ψ's strain space), then
 //!   dJ/dc_j = ∂J/∂c_j − Σ_Δ wᵀ ∇φ_j(S z_Δ), over the coefficients of each triangle's local support.
@@ -38,11 +40,14 @@
 //! Quasi-static simulations without friction only (friction and the dynamic terms lag data of the previous
 //! step): [`ShellError::AdjointUnsupported`] otherwise.
 
+mod boundary;
+
 use super::{obstacle, Simulation};
 use crate::material::coefficients::{BasisEvaluator, Coefficient, MaterialGradient};
-use crate::shell::assemble::{assemble, gather, zero_absent_flaps};
+use crate::shell::assemble::{assemble, gather};
 use crate::shell::strain::{StrainChain, NDOF};
 use crate::shell::{Psd, ShellError};
+pub use boundary::HeldGradient;
 
 /// A scalar function of the equilibrium.
 #[derive(Clone, Debug, PartialEq)]
@@ -75,6 +80,10 @@ pub struct Sensitivity {
     pub gravity: [f64; 3],
     /// dJ/dc_j for every coefficient of the model's material (in its layout; `None` unless asked for)
     pub material: Option<MaterialGradient>,
+    /// dJ/dT and dJ/d(keyframe offsets) of every held set: the handles in order, then `pinned`
+    pub held: Vec<HeldGradient>,
+    /// dJ/dTᵢ for a translation of each obstacle, in order
+    pub obstacles: Vec<[f64; 3]>,
 }
 
 impl Sensitivity {
@@ -242,43 +251,14 @@ impl Simulation {
                             u[3 * v + axis] = 1.0;
                             j += ex.g_full[3 * v + axis];
                         }
-                        self.hessian_times_indicator(&u, &mut djdx)?;
+                        let free = |v: usize| self.pattern.free[v].is_some();
+                        self.hessian_times(&u, &free, &mut djdx)?;
                         j
                     }
                 }
             }
         };
         Ok((value, djdx, u))
-    }
-
-    /// out += (H_full u) on the free dofs, for u supported on held dofs: only the elastic triangles couple held
-    /// and free vertices (the per-vertex terms are block diagonal).
-    fn hessian_times_indicator(&self, u: &[f64], out: &mut [f64]) -> Result<(), ShellError> {
-        let mut model = self.model.clone();
-        model.psd = Psd::None;
-        let mut g = [0.0; NDOF];
-        let mut h = [[0.0; NDOF]; NDOF];
-        for st in &self.stencils {
-            let ul = gather(st, u);
-            if ul.iter().all(|&a| a == 0.0) {
-                continue;
-            }
-            let q = gather(st, &self.x);
-            model
-                .energy_gradient_hessian(&q, &st.rest, st.flaps, &mut g, &mut h)
-                .ok_or(ShellError::Degenerate { step: self.steps })?;
-            zero_absent_flaps(&mut h, st, model.bending);
-            for a in 0..6 {
-                if (a >= 3 && !st.flaps[a - 3]) || self.pattern.free[st.v[a]].is_none() {
-                    continue;
-                }
-                for c in 0..3 {
-                    let r = 3 * a + c;
-                    out[3 * st.v[a] + c] += (0..NDOF).map(|j| h[r][j] * ul[j]).sum::<f64>();
-                }
-            }
-        }
-        Ok(())
     }
 
     /// dJ/dp of `obs` at the current state, which must be a converged quasi-static equilibrium (module
@@ -325,6 +305,8 @@ impl Simulation {
             mass_scale: 0.0,
             gravity: [0.0; 3],
             material: None,
+            held: self.held_gradients(obs, &mu, &djdx)?,
+            obstacles: self.obstacle_gradients(&mu),
         };
         let energy = matches!(obs, Observable::ElasticEnergy);
         // per vertex: gravity and the mass scale
