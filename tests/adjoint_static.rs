@@ -295,6 +295,7 @@ fn compare(
 fn label(o: &Observable) -> String {
     match o {
         Observable::Target { .. } => "target".into(),
+        Observable::Linear { .. } => "linear".into(),
         o => format!("{o:?}"),
     }
 }
@@ -366,6 +367,19 @@ fn stretch_sensitivities_match_resolves() {
         Observable::ElasticEnergy,
         target(&base),
     ];
+    let mut obs = obs;
+    // a cotangent on the positions (the vector–Jacobian product)
+    let weights = (0..base.pattern.n)
+        .map(|v| {
+            let a = v as f64;
+            [
+                (0.7 * a).sin(),
+                0.3 * (1.3 * a).cos(),
+                1.0 + (0.1 * a).sin(),
+            ]
+        })
+        .collect();
+    obs.push(Observable::Linear { weights });
     compare("stretch-x", &s, &obs, true, &[]);
 }
 

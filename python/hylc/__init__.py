@@ -10,7 +10,9 @@ The compiled module ``hylc._hylc`` does the work; this package re-exports it:
   :func:`save_yarn`;
 - materials: :class:`Material` (``load``, ``default``, ``save``, ``psi``, ``gradient``, ``hessian``, ``eval`` over
   (N, 6) arrays) and :func:`fit` (Algorithm C5 on a sample file);
-- cloth: :func:`simulate` (a scene file or built-in; the step log as arrays and the final positions).
+- cloth: :func:`simulate` (a scene file or built-in; the step log as arrays and the final positions) and
+  :func:`gradient` (dJ/dp of an observable of a quasi-static scene, or a vector–Jacobian product, by one adjoint
+  solve).
 
 Errors: bad arguments raise ``ValueError``, missing files ``FileNotFoundError``, failures of the library a
 subclass of :class:`Error`, with the message the command line prints after ``error:``. The GIL is released while
@@ -33,6 +35,7 @@ from ._hylc import (
     __version__,
     fit,
     generate,
+    gradient,
     load_pattern,
     load_yarn,
     read_pyp,
@@ -68,6 +71,7 @@ __all__ = [
     "__version__",
     "fit",
     "generate",
+    "gradient",
     "load_pattern",
     "load_yarn",
     "read_pyp",

@@ -115,3 +115,12 @@ def simulate(
     edge: Optional[float] = None,
     time_tol: Optional[float] = None,
 ) -> dict[str, Any]: ...
+def gradient(
+    scene: str,
+    observable: Optional[str] = None,
+    cotangent: Optional[Any] = None,
+    at: Optional[float] = None,
+    material: Optional[str] = None,
+    out: Optional[StrPath] = None,
+    check: bool = False,
+) -> dict[str, Any]: ...

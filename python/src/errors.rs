@@ -181,6 +181,7 @@ impl From<hylc::workflow::WorkflowError> for HyError {
             W::Reference { .. } => Kind::Micro,
             W::Fit { .. } => Kind::Fit,
             W::Input(_) => Kind::Value,
+            W::NoGradient(_) => Kind::Simulation,
             W::Io { .. } => Kind::Value,
         };
         HyError::from_library(kind, &e)

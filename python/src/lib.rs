@@ -7,6 +7,7 @@ mod arrays;
 mod cloth;
 mod convert;
 mod errors;
+mod gradient;
 mod material;
 mod micro;
 mod pattern;
@@ -38,6 +39,7 @@ fn _hylc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(yarn::save_yarn, m)?)?;
     m.add_function(wrap_pyfunction!(material::fit, m)?)?;
     m.add_function(wrap_pyfunction!(cloth::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(gradient::gradient, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_at_the_boundary, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -115,3 +115,44 @@ def test_a_panic_becomes_an_internal_error():
         _hylc._panic_at_the_boundary()
     # the interpreter goes on
     assert hylc.Material.default().psi([0.0] * 6) == hylc.Material.default().psi(np.zeros(6))
+
+
+def _quasi_static_stretch(tmp_path, cli):
+    """`stretch-x` made quasi-static and coarse (three load steps), written as a scene file."""
+    s = json.loads(cli("simulate", "stretch-x", "--print").stdout)
+    s.update(quasi_static=True, duration=0.15, dt=0.05, drag=0.0)
+    s["mesh"]["rectangle"]["edge"] = 0.3 / 12
+    f = tmp_path / "stretch.json"
+    f.write_text(json.dumps(s))
+    return str(f)
+
+
+def _obj_vertices(path):
+    return np.array([[float(t) for t in line.split()[1:4]] for line in open(path) if line.startswith("v ")])
+
+
+def test_gradient_equals_the_cli_and_the_vjp_equals_a_target(tmp_path, cli):
+    scene = _quasi_static_stretch(tmp_path, cli)
+    cli("gradient", scene, "--observable", "handle-force:right:x", "--out", tmp_path / "cli", "--quiet")
+    expected = json.loads((tmp_path / "cli" / "gradient.json").read_text())
+    g = hylc.gradient(scene, observable="handle-force:right:x", out=tmp_path / "py")
+    assert g["value"] == pytest.approx(expected["value"], rel=1e-12)
+    assert g["scene"]["stiffness"] == pytest.approx(expected["scene"]["stiffness"], rel=1e-10)
+    assert g["held"]["right"]["keyframes"].shape == (2, 3)
+    np.testing.assert_allclose(g["held"]["right"]["keyframes"], expected["held"]["right"]["keyframes"], rtol=1e-10)
+    p = g["material"]["coeffs"]["1D"][0]["p"]
+    assert isinstance(p, np.ndarray) and np.abs(p).max() > 0
+    # the vector–Jacobian product with w = x* − x̂ is the gradient of the target ½|x − x̂|² at x*
+    x_hat = _obj_vertices(tmp_path / "py" / "frame_0000.obj")
+    x_star = _obj_vertices(tmp_path / "py" / "frame_0003.obj")
+    target = hylc.gradient(scene, observable=f"target:{tmp_path / 'py' / 'frame_0000.obj'}")
+    vjp = hylc.gradient(scene, cotangent=x_star - x_hat)
+    for key in ["stiffness", "bending_scale", "mass"]:
+        assert vjp["scene"][key] == pytest.approx(target["scene"][key], rel=1e-6, abs=1e-12)
+    np.testing.assert_allclose(vjp["held"]["left"]["translation"], target["held"]["left"]["translation"], rtol=1e-6)
+    with pytest.raises(ValueError, match="exactly one"):
+        hylc.gradient(scene)
+    with pytest.raises(ValueError, match="cotangent"):
+        hylc.gradient(scene, cotangent=np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="quasi-static"):
+        hylc.gradient("stretch-x", observable="energy")

@@ -34,6 +34,24 @@ pub enum Coefficient {
     },
 }
 
+/// The coefficient's place in the material file: `coeffs.const`, `coeffs.1D[term].p[index]` (or `.m`),
+/// `coeffs.2D[term].mu[index]` (or `.p`, `.mv`, `.muv`).
+impl std::fmt::Display for Coefficient {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Coefficient::Constant => write!(f, "coeffs.const"),
+            Coefficient::Term1D { term, slope, index } => {
+                let a = if slope { "m" } else { "p" };
+                write!(f, "coeffs.1D[{term}].{a}[{index}]")
+            }
+            Coefficient::Term2D { term, array, index } => {
+                let a = ["p", "mu", "mv", "muv"][array];
+                write!(f, "coeffs.2D[{term}].{a}[{index}]")
+            }
+        }
+    }
+}
+
 /// One number per coefficient of a material, in its layout (e.g. dJ/dc_j).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MaterialGradient {

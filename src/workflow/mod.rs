@@ -6,6 +6,7 @@
 //! - [`sidecar`]: the `SAMPLES.meta.json` file beside a sample file (plan, pattern, yarn, solver, density);
 //! - [`fit`]: Algorithm C5 on a sample file, with the material, the JSON report and the plots written;
 //! - [`simulate`]: a cloth scene (C8) with overrides, its frames, log and PNG snapshot;
+//! - [`gradient`]: dJ/dp of an observable of a quasi-static scene by one adjoint solve, with an optional check;
 //! - [`pipeline`]: the main job `hylc run` (C1 → C4 → C5–C7 → C8) end to end.
 //!
 //! Nothing here prints: what a terminal would show goes to an [`Event`] callback (`Send`, because sampling reports
@@ -26,6 +27,7 @@
 //! ```
 
 pub mod fit;
+pub mod gradient;
 pub mod inputs;
 pub mod pipeline;
 pub mod sidecar;
@@ -91,6 +93,9 @@ pub enum WorkflowError {
     /// Bad input to a workflow, with the argument or file at fault.
     #[error("{0}")]
     Input(String),
+    /// A gradient asked for where none exists (an unconverged state).
+    #[error("{0}")]
+    NoGradient(String),
 }
 
 impl WorkflowError {

@@ -9,6 +9,7 @@ mod compare_samples;
 mod fit;
 mod fuzz;
 mod generate;
+mod gradient;
 mod identify;
 mod material;
 mod merge;
@@ -59,6 +60,7 @@ enum Command {
     Identify(identify::Args),
     Fuzz(fuzz::Args),
     Simulate(simulate::Args),
+    Gradient(gradient::Args),
     Yarn(yarn::Args),
 }
 
@@ -124,6 +126,7 @@ fn main() -> ExitCode {
         Command::Identify(a) => identify::run(a),
         Command::Fuzz(a) => fuzz::run_cmd(a),
         Command::Simulate(a) => simulate::run(a),
+        Command::Gradient(a) => gradient::run(a),
         Command::Yarn(a) => yarn::run(a),
     };
     match result {

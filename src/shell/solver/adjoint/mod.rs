@@ -35,7 +35,8 @@
 //!   R = uᵀ ∇Φ_full with u the indicator of the set's dofs of component c, so ∂R/∂x_f = (H_full u)_f (the
 //!   free–held block) and ∂R/∂p = uᵀ ∂∇Φ/∂p: both fold into dJ/dp = −(λ − u)ᵀ ∂∇Φ/∂p; with springs
 //!   R = Σ k (p_v − x_v), ∂R/∂x_v = −k e_c, no explicit p dependence;
-//! - `target` ½ Σ_v |x_v − x̂_v|² over all vertices: ∂J/∂x = x − x̂.
+//! - `target` ½ Σ_v |x_v − x̂_v|² over all vertices: ∂J/∂x = x − x̂;
+//! - `linear` Σ_v w_v · x_v for a cotangent w: ∂J/∂x = w, so dJ/dp = wᵀ dx*/dp (a vector–Jacobian product).
 //!
 //! Quasi-static simulations without friction only (friction and the dynamic terms lag data of the previous
 //! step): [`ShellError::AdjointUnsupported`] otherwise.
@@ -61,6 +62,9 @@ pub enum Observable {
     Reaction { set: String, axis: usize },
     /// ½ Σ_v |x_v − x̂_v|² over every vertex
     Target { positions: Vec<[f64; 3]> },
+    /// Σ_v w_v · x_v: with w a cotangent on the positions, the gradient is the vector–Jacobian product
+    /// wᵀ dx*/dp
+    Linear { weights: Vec<[f64; 3]> },
 }
 
 /// dJ/dp of one observable at an equilibrium.
@@ -228,6 +232,21 @@ impl Simulation {
                         let d = x[3 * v + c] - positions[v][c];
                         j += 0.5 * d * d;
                         djdx[3 * v + c] = d;
+                    }
+                }
+                j
+            }
+            Observable::Linear { weights } => {
+                if weights.len() != n {
+                    return Err(ShellError::AdjointUnsupported {
+                        reason: "the cotangent has not one vector per vertex",
+                    });
+                }
+                let mut j = 0.0;
+                for v in 0..n {
+                    for c in 0..3 {
+                        j += weights[v][c] * x[3 * v + c];
+                        djdx[3 * v + c] = weights[v][c];
                     }
                 }
                 j
