@@ -1,7 +1,7 @@
 //! `hylc gradient` end to end (docs/sensitivities.md): on a coarse quasi-static stretch over a sphere, the adjoint
 //! gradient of a handle force agrees with the command's own central differences of re-solves (`--check`) for
 //! every scene scalar, keyframe, obstacle coordinate and the five largest material coefficients, relative error
-//! ≤ 1e-5; `gradient.json` holds the material's gradient in the material file's layout; a target observable is
+//! ≤ 1e-5; the same stretch run dynamically (three steps), the trajectory gradient of its centre of mass ≤ 1e-4; `gradient.json` holds the material's gradient in the material file's layout; a target observable is
 //! zero at its own frame. Bad input exits 2 with a message naming the value at fault; no gradient exits 3.
 
 use serde_json::Value;
@@ -103,6 +103,34 @@ fn gradient_matches_its_check_and_writes_the_material_layout() {
 }
 
 #[test]
+fn dynamic_gradient_matches_its_check() {
+    let dir = folder("dynamic");
+    let f = scene(&dir, "stretch-x", 0.3 / 12.0, 0.05, 1.0 / 60.0, |s| {
+        s["quasi_static"] = false.into();
+    });
+    let out = dir.join("out");
+    let (code, stdout, stderr) = hylc(&[
+        "gradient",
+        &f,
+        "--observable",
+        "com-z",
+        "--check",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    let g: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("gradient.json")).unwrap()).unwrap();
+    assert!((g["time"].as_f64().unwrap() - 0.05).abs() < 1e-12);
+    let check = g["check"].as_array().unwrap();
+    assert_eq!(check.len(), 6 + 12 + 5, "{check:?}");
+    for r in check {
+        assert!(r["error"].as_f64().unwrap() <= 1e-4, "{r}");
+    }
+}
+
+#[test]
 fn target_observable_and_bad_input() {
     let dir = folder("input");
     let f = scene(&dir, "stretch-x", 0.3 / 6.0, 0.1, 0.05, |_| {});
@@ -152,17 +180,22 @@ fn target_observable_and_bad_input() {
     ]);
     let other = format!("target:{}", dir.join("h").join("frame_0000.obj").display());
     bad(&["--observable", &other], "vertices");
-    // a dynamic scene
+    // a dynamic scene with damping, which the trajectory adjoint does not follow
+    let damped = scene(&dir, "stretch-x", 0.3 / 6.0, 0.05, 1.0 / 60.0, |s| {
+        s["quasi_static"] = false.into();
+        s["damping"] = 0.01.into();
+    });
     let (code, _, stderr) = hylc(&[
         "gradient",
-        "stretch-x",
+        &damped,
         "--observable",
         "energy",
         "--out",
         o,
+        "--quiet",
     ]);
     assert_eq!(code, 2, "{stderr}");
-    assert!(stderr.contains("quasi-static"), "{stderr}");
+    assert!(stderr.contains("damping"), "{stderr}");
     // the flat hanging cloth's equilibrium is a saddle: no gradient, exit 3
     let flat = scene(&dir, "hanging", 0.3 / 6.0, 1.0, 1.0, |_| {});
     let (code, _, stderr) = hylc(&[

@@ -1,5 +1,5 @@
-//! Sensitivities of a quasi-static cloth scene (`hylc gradient`, docs/sensitivities.md): dJ/dp of an observable,
-//! or the vector–Jacobian product of a cotangent on the final positions, by one adjoint solve.
+//! Sensitivities of a cloth scene (`hylc gradient`, docs/sensitivities.md): dJ/dp of an observable, or the
+//! vector–Jacobian product of a cotangent on the final positions, by an adjoint solve.
 
 use crate::arrays::rows;
 use crate::convert::json_to_numpy;
@@ -9,8 +9,9 @@ use hylc::workflow::simulate::{prepare, Overrides};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
-/// dJ/dp at the equilibrium of a quasi-static scene (a scene JSON file or an ARCSim scene with `quasi_static`),
-/// as `hylc gradient` computes it: `observable` is `com-x|y|z`, `energy`, `handle-force:NAME:x|y|z` or
+/// dJ/dp of a scene (a scene JSON file, an ARCSim scene or a built-in) at its last step, as `hylc gradient`
+/// computes it (a quasi-static equilibrium by one adjoint solve, a dynamic run by the discrete adjoint of its
+/// implicit Euler substeps): `observable` is `com-x|y|z`, `energy`, `handle-force:NAME:x|y|z` or
 /// `target:FILE.obj`; or, instead, `cotangent` (vertices, 3) gives J = Σ w_v · x_v, so that the result is the
 /// vector–Jacobian product wᵀ dx*/dp. `at` (s) picks the step nearest it (default the last); `check` adds
 /// central differences of re-solves. Returns the content of `gradient.json` as dicts of numpy arrays:

@@ -1,7 +1,9 @@
-//! `hylc gradient`: dJ/dp of one observable of a quasi-static cloth scene with respect to the scene's scalars,
-//! the held sets' and obstacles' positions and every coefficient of the material, by one adjoint solve at the
-//! equilibrium (`docs/sensitivities.md`; [`crate::shell::solver::Simulation::sensitivity`]), optionally checked
-//! against central differences of re-solves.
+//! `hylc gradient`: dJ/dp of one observable of a cloth scene with respect to the scene's scalars, the held sets'
+//! and obstacles' positions and every coefficient of the material (`docs/sensitivities.md`): for a quasi-static
+//! scene by one adjoint solve at the equilibrium ([`crate::shell::solver::Simulation::sensitivity`]), for a
+//! dynamic one by the discrete adjoint of its implicit Euler substeps as they ran
+//! ([`crate::shell::solver::Simulation::trajectory_sensitivity`]); optionally checked against central
+//! differences of reruns.
 //!
 //! Observables (at the last step, or the step nearest `at`): `com-x|y|z` (the mass-weighted centre), `energy`
 //! (elastic), `handle-force:NAME:x|y|z` (the reaction of a held set, as `handle_forces.csv` reports it),
@@ -140,6 +142,9 @@ fn solve(
 ) -> Result<Simulation, WorkflowError> {
     let (mut sim, tris) = scene.build(scene_arg, dir)?;
     edit(&mut sim);
+    if !scene.quasi_static {
+        sim.start_tape();
+    }
     let mut done = 0;
     let summary = run(&mut sim, &tris, steps, scene.output.obj_every, out, |r| {
         done += 1;
@@ -171,12 +176,6 @@ pub fn gradient(
     opts: &GradientOptions,
     on_event: &mut (dyn FnMut(Event) + Send),
 ) -> Result<GradientOutcome, WorkflowError> {
-    if !scene.quasi_static {
-        return Err(WorkflowError::Input(format!(
-            "{scene_arg}: gradients need a quasi-static scene (\"quasi_static\": true); the trajectory adjoint of \
-             a dynamic run is not available"
-        )));
-    }
     let mut scene = scene.clone();
     if opts.check {
         // differences of re-solves need equilibria far tighter than the scene's force tolerance
@@ -185,7 +184,7 @@ pub fn gradient(
     }
     let steps = steps_to(&scene, opts.at)?;
     let t0 = Instant::now();
-    let sim = solve(&scene, scene_arg, dir, steps, Some(out), &|_| {}, on_event)?;
+    let mut sim = solve(&scene, scene_arg, dir, steps, Some(out), &|_| {}, on_event)?;
     let wall_forward = t0.elapsed().as_secs_f64();
     let obs = match &opts.cotangent {
         Some(w) if w.len() != sim.pattern.n => {
@@ -199,7 +198,13 @@ pub fn gradient(
         None => parse_observable(&opts.observable, &sim)?,
     };
     let t0 = Instant::now();
-    let sens = sim.sensitivity(&obs, true)?;
+    let sens = if scene.quasi_static {
+        sim.sensitivity(&obs, true)?
+    } else {
+        let last = sim.tape().map_or(0, |t| t.steps.len().saturating_sub(1));
+        sim.trajectory_sensitivity(&obs, &[last], true)
+            .map_err(|e| unsupported(scene_arg, e))?
+    };
     let wall_gradient = t0.elapsed().as_secs_f64();
     let check = if opts.check {
         let p = Probe {
@@ -470,6 +475,16 @@ impl Probe<'_> {
                 error: (adjoint - difference).abs() / difference.abs().max(1e-6 * scale / pm),
             })
             .collect())
+    }
+}
+
+/// A trajectory adjoint the scene's settings do not allow, as bad input naming the scene.
+fn unsupported(scene_arg: &str, e: ShellError) -> WorkflowError {
+    match e {
+        ShellError::AdjointUnsupported { reason } => WorkflowError::Input(format!(
+            "{scene_arg}: no trajectory gradient: {reason} (docs/sensitivities.md, \"Trajectories\")"
+        )),
+        e => e.into(),
     }
 }
 

@@ -1,4 +1,4 @@
-//! `hylc gradient SCENE --observable OBS`: dJ/dp of one observable of a quasi-static scene by one adjoint solve
+//! `hylc gradient SCENE --observable OBS`: dJ/dp of one observable of a scene by an adjoint solve
 //! (`hylc::workflow::gradient`, docs/sensitivities.md), written to `OUT/gradient.json`.
 
 use crate::printer::Printer;
@@ -7,21 +7,22 @@ use hylc::workflow::simulate::{prepare_noted, Overrides};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-/// Sensitivities of a quasi-static scene's equilibrium: dJ/dp of one observable for the scene's stiffness,
-/// bending scale, mass and gravity, every held set's translation and keyframe offsets, every obstacle's
-/// translation and every coefficient of the material, by one adjoint solve (docs/sensitivities.md). Writes
-/// OUT/gradient.json (the material's gradient in the material file's layout) and the run's frames and log.
-/// Exit code 0: done; 2: bad input (or a dynamic scene); 3: no gradient exists (the last step did not converge,
-/// or the equilibrium is not a strict minimum).
+/// Sensitivities of a scene: dJ/dp of one observable for the scene's stiffness, bending scale, mass and gravity,
+/// every held set's translation and keyframe offsets, every obstacle's translation and every coefficient of the
+/// material, by one adjoint solve at a quasi-static equilibrium or the discrete adjoint of a dynamic run's
+/// implicit Euler substeps (no damping, air drag or friction; docs/sensitivities.md). Writes OUT/gradient.json
+/// (the material's gradient in the material file's layout) and the run's frames and log. Exit code 0: done;
+/// 2: bad input (or settings the adjoint does not follow); 3: no gradient exists (the last step did not
+/// converge, or an equilibrium is not a strict minimum).
 #[derive(clap::Args)]
 pub struct Args {
-    /// scene JSON file, ARCSim scene file or built-in name; it must be quasi-static
+    /// scene JSON file, ARCSim scene file or built-in name
     scene: String,
     /// the observable J: com-x|y|z (mass-weighted centre), energy (elastic), handle-force:NAME:x|y|z (the
     /// reaction of a held set), target:FILE.obj (½ Σ|x − x̂|² against an OBJ with the scene's vertices)
     #[arg(long)]
     observable: String,
-    /// the time (s) of the equilibrium: the step nearest it (default: the last step)
+    /// the time (s) at which J is taken: the step nearest it (default: the last step)
     #[arg(long, value_name = "SECONDS")]
     at: Option<f64>,
     /// material JSON (or `default`) instead of the scene's

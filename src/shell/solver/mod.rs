@@ -66,7 +66,7 @@ mod terms;
 
 pub use stepping::strain_quantile;
 
-pub use adjoint::{HeldGradient, Observable, Sensitivity};
+pub use adjoint::{HeldGradient, Observable, Sensitivity, Tape, TapeStep};
 pub use integrator::{bdf2_coefficients, Integrator};
 use integrator::{Anchor, History};
 
@@ -294,6 +294,8 @@ pub struct Simulation {
     /// the local PSD Hessians at the state `.0` (the last converged assembly), which the next substep's damping
     /// reuses instead of assembling them again
     damping_cache: Option<DampingCache>,
+    /// the states of the run for its adjoint, when recorded ([`Simulation::start_tape`])
+    tape: Option<Tape>,
 }
 
 /// The state and the local PSD Hessians assembled there.
@@ -444,6 +446,7 @@ impl Simulation {
             h_next: settings_dt,
             history: None,
             damping_cache: None,
+            tape: None,
         })
     }
 
@@ -586,6 +589,13 @@ impl Simulation {
         self.x.clone_from(&m.x);
         self.time += tg.step;
         self.history = start;
+        if let Some(tape) = self.tape.as_mut() {
+            tape.steps.push(TapeStep {
+                h: tg.step,
+                time: self.time,
+                x: self.x.clone(),
+            });
+        }
     }
 
     /// The prescribed position of every held vertex at time t (pins at x0, handles at x0 + offset).

@@ -42,6 +42,7 @@
 //! step): [`ShellError::AdjointUnsupported`] otherwise.
 
 mod boundary;
+mod trajectory;
 
 use super::{obstacle, Simulation};
 use crate::material::coefficients::{BasisEvaluator, Coefficient, MaterialGradient};
@@ -49,6 +50,7 @@ use crate::shell::assemble::{assemble, gather};
 use crate::shell::strain::{StrainChain, NDOF};
 use crate::shell::{Psd, ShellError};
 pub use boundary::HeldGradient;
+pub use trajectory::{Tape, TapeStep};
 
 /// A scalar function of the equilibrium.
 #[derive(Clone, Debug, PartialEq)]
@@ -323,23 +325,37 @@ impl Simulation {
             bending_scale: 0.0,
             mass_scale: 0.0,
             gravity: [0.0; 3],
-            material: None,
+            material: material.then(|| MaterialGradient::zeros(&self.model.material)),
             held: self.held_gradients(obs, &mu, &djdx)?,
             obstacles: self.obstacle_gradients(&mu),
         };
         let energy = matches!(obs, Observable::ElasticEnergy);
+        self.add_parameter_terms(&mu, &ex.g_mass, energy, &mut out)?;
+        Ok(out)
+    }
+
+    /// Add −μᵀ ∂∇Φ/∂p at the current state to `out` for gravity, the mass scale (`g_mass` the gradient of the
+    /// terms proportional to the masses), the stiffness, the bending scale and (when `out.material` is `Some`)
+    /// every material coefficient; with `energy` also the elastic energy's explicit ∂E/∂p (module
+    /// documentation).
+    fn add_parameter_terms(
+        &self,
+        mu: &[f64],
+        g_mass: &[f64],
+        energy: bool,
+        out: &mut Sensitivity,
+    ) -> Result<(), ShellError> {
         // per vertex: gravity and the mass scale
-        for v in 0..n {
+        for v in 0..self.pattern.n {
             for c in 0..3 {
                 let i = 3 * v + c;
                 out.gravity[c] += self.mass[v] * mu[i];
-                out.mass_scale -= mu[i] * ex.g_mass[i];
+                out.mass_scale -= mu[i] * g_mass[i];
             }
         }
         // per triangle: stiffness, bending scale, material coefficients
         let model = &self.model;
         let mat = &model.material;
-        let mut grad_c = material.then(|| MaterialGradient::zeros(mat));
         let mut basis = BasisEvaluator::new(mat);
         let b = model.bending_scale;
         let sv = [1.0, 1.0, 1.0, b, b, b];
@@ -348,7 +364,7 @@ impl Simulation {
             let q = gather(st, &self.x);
             let ch = StrainChain::new(&q, &st.rest, flaps)
                 .ok_or(ShellError::Degenerate { step: self.steps })?;
-            let ml = gather(st, &mu);
+            let ml = gather(st, mu);
             let w6: [f64; 6] =
                 std::array::from_fn(|k| (0..NDOF).map(|j| ch.jac[k][j] * ml[j]).sum());
             let z = ch.z;
@@ -376,7 +392,7 @@ impl Simulation {
                 out.stiffness += a * p.value;
                 out.bending_scale += ak * (3..6).map(|l| p.grad[l] * z[l]).sum::<f64>();
             }
-            if let Some(gc) = grad_c.as_mut() {
+            if let Some(gc) = out.material.as_mut() {
                 let wm: [f64; 6] = std::array::from_fn(|k| ak * sv[k] * w6[k]);
                 for c in mat.support(&sz) {
                     let (phi, gphi) = basis.basis(c, &sz);
@@ -391,8 +407,7 @@ impl Simulation {
                 }
             }
         }
-        out.material = grad_c;
-        Ok(out)
+        Ok(())
     }
 }
 
