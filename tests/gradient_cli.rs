@@ -128,6 +128,28 @@ fn dynamic_gradient_matches_its_check() {
     for r in check {
         assert!(r["error"].as_f64().unwrap() <= 1e-4, "{r}");
     }
+    // a handle's reaction (with the held vertices' inertia) at the second step
+    let (code, stdout, stderr) = hylc(&[
+        "gradient",
+        &f,
+        "--observable",
+        "handle-force:right:x",
+        "--at",
+        "0.0333",
+        "--check",
+        "--check-coefficients",
+        "2",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stdout}\n{stderr}");
+    let g: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("gradient.json")).unwrap()).unwrap();
+    assert!((g["time"].as_f64().unwrap() - 2.0 / 60.0).abs() < 1e-12);
+    for r in g["check"].as_array().unwrap() {
+        assert!(r["error"].as_f64().unwrap() <= 1e-4, "{r}");
+    }
 }
 
 #[test]

@@ -129,8 +129,8 @@ fn steps_to(scene: &Scene, at: Option<f64>) -> Result<usize, WorkflowError> {
     Ok(k as usize)
 }
 
-/// Build `scene` and solve it for `steps` steps (writing frames and log to `out` when given); an error when the
-/// last step did not converge (no gradient of an unconverged state).
+/// Build `scene` and solve it for `steps` steps (writing frames and log to `out` when given); the simulation and
+/// the last step's reactions; an error when the last step did not converge (no gradient of an unconverged state).
 fn solve(
     scene: &Scene,
     scene_arg: &str,
@@ -139,7 +139,7 @@ fn solve(
     out: Option<&Path>,
     edit: &dyn Fn(&mut Simulation),
     on_event: &mut (dyn FnMut(Event) + Send),
-) -> Result<Simulation, WorkflowError> {
+) -> Result<(Simulation, Vec<(String, [f64; 3])>), WorkflowError> {
     let (mut sim, tris) = scene.build(scene_arg, dir)?;
     edit(&mut sim);
     if !scene.quasi_static {
@@ -162,7 +162,8 @@ fn solve(
              unconverged state",
             r.time, r.residual
         ))),
-        _ => Ok(sim),
+        Some(r) => Ok((sim, r.handle_forces)),
+        None => Ok((sim, vec![])),
     }
 }
 
@@ -184,7 +185,7 @@ pub fn gradient(
     }
     let steps = steps_to(&scene, opts.at)?;
     let t0 = Instant::now();
-    let mut sim = solve(&scene, scene_arg, dir, steps, Some(out), &|_| {}, on_event)?;
+    let (mut sim, _) = solve(&scene, scene_arg, dir, steps, Some(out), &|_| {}, on_event)?;
     let wall_forward = t0.elapsed().as_secs_f64();
     let obs = match &opts.cotangent {
         Some(w) if w.len() != sim.pattern.n => {
@@ -340,7 +341,7 @@ impl Probe<'_> {
             }
             _ => {}
         };
-        let sim = solve(
+        let (sim, forces) = solve(
             &s,
             self.scene_arg,
             self.dir,
@@ -349,7 +350,15 @@ impl Probe<'_> {
             &edit,
             &mut |_| {},
         )?;
-        Ok(sim.observable(self.obs)?)
+        match self.obs {
+            // a dynamic run's reaction includes the held vertices' inertia: the step report's
+            Observable::Reaction { set, axis } if !s.quasi_static => forces
+                .iter()
+                .find(|f| &f.0 == set)
+                .map(|f| f.1[*axis])
+                .ok_or_else(|| WorkflowError::Input(format!("no held set {set:?}"))),
+            obs => Ok(sim.observable(obs)?),
+        }
     }
 
     /// The parameters to check, their names, values and adjoint derivatives.

@@ -90,12 +90,14 @@ impl Simulation {
     }
 
     /// dJ/dT of every held set and dJ/doᵢ of its keyframes (module documentation), from μ = λ − u and the
-    /// observable's explicit ∂J/∂x over all dofs.
+    /// observable's explicit ∂J/∂x over all dofs; `obs` `None` where J is not observed (a substep of a
+    /// trajectory), `inertia` the diagonal m (1/h² + c/h) / m of a dynamic substep's Hessian (0 when static).
     pub(super) fn held_gradients(
         &self,
-        obs: &Observable,
+        obs: Option<&Observable>,
         mu: &[f64],
         djdx: &[f64],
+        inertia: f64,
     ) -> Result<Vec<HeldGradient>, ShellError> {
         let n = self.pattern.n;
         // dJ/dx_v for every held vertex (hard) or dJ/dp_v for every spring target
@@ -106,8 +108,10 @@ impl Simulation {
                 let mut hmu = vec![0.0; 3 * n];
                 self.hessian_times(mu, &held, &mut hmu)?;
                 for v in (0..n).filter(|&v| held(v)) {
+                    let m = inertia * self.mass[v];
                     for c in 0..3 {
-                        d[3 * v + c] = djdx[3 * v + c] - hmu[3 * v + c];
+                        let i = 3 * v + c;
+                        d[i] = djdx[i] - hmu[i] - m * mu[i];
                     }
                 }
             }
@@ -129,7 +133,7 @@ impl Simulation {
             sets.push(("pinned", &self.pinned, vec![]));
         }
         let spring_reaction = match (obs, self.settings.handle_stiffness) {
-            (Observable::Reaction { set, axis }, Some(k)) => Some((set.as_str(), *axis, k)),
+            (Some(Observable::Reaction { set, axis }), Some(k)) => Some((set.as_str(), *axis, k)),
             _ => None,
         };
         Ok(sets

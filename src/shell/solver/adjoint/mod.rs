@@ -326,7 +326,7 @@ impl Simulation {
             mass_scale: 0.0,
             gravity: [0.0; 3],
             material: material.then(|| MaterialGradient::zeros(&self.model.material)),
-            held: self.held_gradients(obs, &mu, &djdx)?,
+            held: self.held_gradients(Some(obs), &mu, &djdx, 0.0)?,
             obstacles: self.obstacle_gradients(&mu),
         };
         let energy = matches!(obs, Observable::ElasticEnergy);

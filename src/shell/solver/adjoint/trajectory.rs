@@ -19,10 +19,14 @@
 //! initial state is the scene's and depends on no parameter). The forward run records every accepted substep's
 //! length, end time and state ([`Tape`]); its memory is 8 · 3n bytes per substep (reported by [`Tape::bytes`]).
 //!
+//! A reaction observed at t_{k+1} (hard constraints) is uᵀ ∂Φ_k/∂x over the set's dofs, inertia and drag of the
+//! held vertices included: as in the static case μ = λ − u replaces λ in the parameter terms, and the held
+//! dofs' −μ = u carries its ∂/∂x_k and ∂/∂v_k into x̄_k = μ m (1/h² + c/h) − v̄/h and v̄_k = μ m/h.
+//!
 //! Supported: implicit Euler (fixed or adaptive substeps: the recorded ones), elastic energy, gravity, linear
 //! drag, obstacle penalties, hard constraints and handle springs. Not: stiffness-proportional damping and air
 //! drag (their Hessians and faces are lagged at x_k and would need the energy's third derivatives), friction,
-//! BDF2 and the linearised scheme, reaction observables: [`ShellError::AdjointUnsupported`].
+//! BDF2 and the linearised scheme: [`ShellError::AdjointUnsupported`].
 
 use super::{HeldGradient, Observable, Sensitivity, Simulation};
 use crate::material::coefficients::MaterialGradient;
@@ -84,7 +88,7 @@ impl Simulation {
         self.tape.as_ref()
     }
 
-    fn trajectory_supported(&self, obs: &Observable) -> Result<(), ShellError> {
+    fn trajectory_supported(&self) -> Result<(), ShellError> {
         let s = &self.settings;
         let reason = if s.quasi_static {
             "the simulation is quasi-static (use the static sensitivity)"
@@ -96,8 +100,6 @@ impl Simulation {
             "air drag lags its faces at the step's start"
         } else if s.friction > 0.0 {
             "friction lags the previous step's contacts"
-        } else if matches!(obs, Observable::Reaction { .. }) {
-            "a reaction of a dynamic run depends on the inertia of the held vertices"
         } else if self.tape.as_ref().is_none_or(|t| t.steps.is_empty()) {
             "no substep was recorded (start_tape before stepping)"
         } else {
@@ -115,7 +117,7 @@ impl Simulation {
         at: &[usize],
         material: bool,
     ) -> Result<Sensitivity, ShellError> {
-        self.trajectory_supported(obs)?;
+        self.trajectory_supported()?;
         let tape = self.tape.take().expect("checked above");
         let saved = (self.x.clone(), self.time);
         let out = self.reverse_pass(&tape, obs, at, material);
@@ -168,31 +170,39 @@ impl Simulation {
             self.x.clone_from(&st.x);
             self.time = st.time;
             let mut ex = self.exact_system()?;
+            // the inertia and drag terms of Φ_k: their gradient (a reaction includes them, and they are
+            // proportional to the masses) and their Hessian diagonal m (1/h² + c/h)
+            let inertia = 1.0 / (h * h) + c_drag / h;
+            for v in 0..n {
+                let m = self.mass[v];
+                for c in 0..3 {
+                    let i = 3 * v + c;
+                    let g = m * (st.x[i] - xk[i] - h * vk[i]) / (h * h)
+                        + c_drag * m * (st.x[i] - xk[i]) / h;
+                    ex.g_mass[i] += g;
+                    ex.g_full[i] += g;
+                }
+                if let Some(f) = self.pattern.free[v] {
+                    let d = m * inertia;
+                    let blk =
+                        std::array::from_fn(|r| std::array::from_fn(|s| d * f64::from(r == s)));
+                    self.pattern.add_diag_block(&mut ex.values, f, &blk);
+                }
+            }
             let observed = at.contains(&k);
+            let mut u = vec![0.0; 3 * n];
             if observed {
-                let (value, djdx, _) = self.observable_parts(obs, &ex)?;
+                let (value, djdx, uo) = self.observable_parts(obs, &ex)?;
                 out.value += value;
                 for (a, b) in xbar.iter_mut().zip(&djdx) {
                     *a += b;
                 }
+                u = uo;
             }
-            // the inertia and drag terms of Φ_k: Hessian diagonal, and their part of ∂G/∂μ
-            let mut rhs = vec![0.0; 3 * self.pattern.nfree];
             let a: Vec<f64> = (0..3 * n).map(|i| xbar[i] + vbar[i] / h).collect();
+            let mut rhs = vec![0.0; 3 * self.pattern.nfree];
             for v in 0..n {
-                let m = self.mass[v];
-                let d = m * (1.0 / (h * h) + c_drag / h);
-                for c in 0..3 {
-                    let i = 3 * v + c;
-                    ex.g_mass[i] += m * (st.x[i] - xk[i] - h * vk[i]) / (h * h)
-                        + c_drag * m * (st.x[i] - xk[i]) / h;
-                    ex.g_full[i] += m * (st.x[i] - xk[i] - h * vk[i]) / (h * h)
-                        + c_drag * m * (st.x[i] - xk[i]) / h;
-                }
                 if let Some(f) = self.pattern.free[v] {
-                    let blk =
-                        std::array::from_fn(|r| std::array::from_fn(|s| d * f64::from(r == s)));
-                    self.pattern.add_diag_block(&mut ex.values, f, &blk);
                     let r2: f64 = (0..3).map(|c| ex.g_full[3 * v + c].powi(2)).sum();
                     out.residual = out.residual.max(r2.sqrt());
                     for c in 0..3 {
@@ -204,34 +214,30 @@ impl Simulation {
             let neg_lambda = self
                 .factor_solve(&ex.values, &rhs)
                 .ok_or(ShellError::NotStrictMinimum { residual })?;
-            let mut mu = vec![0.0; 3 * n];
+            // μ = λ − u over all dofs (u the reaction's indicator where observed)
+            let mut mu: Vec<f64> = u.iter().map(|a| -a).collect();
             for v in 0..n {
                 if let Some(f) = self.pattern.free[v] {
                     for c in 0..3 {
-                        mu[3 * v + c] = -neg_lambda[3 * f + c];
+                        mu[3 * v + c] -= neg_lambda[3 * f + c];
                     }
                 }
             }
             self.add_parameter_terms(&mu, &ex.g_mass, energy && observed, &mut out)?;
-            accumulate_held(&mut out.held, self.held_gradients(obs, &mu, &a)?);
+            let seen = observed.then_some(obs);
+            accumulate_held(&mut out.held, self.held_gradients(seen, &mu, &a, inertia)?);
             for (t, g) in out.obstacles.iter_mut().zip(self.obstacle_gradients(&mu)) {
                 for c in 0..3 {
                     t[c] += g[c];
                 }
             }
-            // back to the substep's start
+            // back to the substep's start: −μᵀ ∂G/∂x_k and −μᵀ ∂G/∂v_k on every dof (a held dof's μ is −u)
             for v in 0..n {
                 let m = self.mass[v];
-                let free = self.pattern.free[v].is_some();
                 for c in 0..3 {
                     let i = 3 * v + c;
-                    let vb = vbar[i];
-                    xbar[i] = if free {
-                        mu[i] * m * (1.0 / (h * h) + c_drag / h)
-                    } else {
-                        0.0
-                    } - vb / h;
-                    vbar[i] = if free { mu[i] * m / h } else { 0.0 };
+                    xbar[i] = mu[i] * m * inertia - vbar[i] / h;
+                    vbar[i] = mu[i] * m / h;
                 }
             }
         }
