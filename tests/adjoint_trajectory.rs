@@ -46,8 +46,11 @@ enum Param {
     Coef(Coefficient),
 }
 
+/// A finished run and its last step's reactions.
+type Run = (Simulation, Vec<(String, [f64; 3])>);
+
 /// The run of `s` with `p` moved by `d`, its tape recorded, and the last step's reactions.
-fn run(s: &Scene, p: Param, d: f64) -> (Simulation, Vec<(String, [f64; 3])>) {
+fn run(s: &Scene, p: Param, d: f64) -> Run {
     let mut s = s.clone();
     match p {
         Param::Stiffness => s.model.stiffness += d,
@@ -77,7 +80,7 @@ fn run(s: &Scene, p: Param, d: f64) -> (Simulation, Vec<(String, [f64; 3])>) {
 }
 
 /// J summed over the substeps `at` of a finished run (a reaction at the last one: the step report's).
-fn value(run: &mut (Simulation, Vec<(String, [f64; 3])>), obs: &Observable, at: &[usize]) -> f64 {
+fn value(run: &mut Run, obs: &Observable, at: &[usize]) -> f64 {
     if let Observable::Reaction { set, axis } = obs {
         return run.1.iter().find(|f| &f.0 == set).unwrap().1[*axis];
     }

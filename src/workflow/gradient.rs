@@ -129,6 +129,9 @@ fn steps_to(scene: &Scene, at: Option<f64>) -> Result<usize, WorkflowError> {
     Ok(k as usize)
 }
 
+/// Every held set's reaction at a step (N), by name.
+type Reactions = Vec<(String, [f64; 3])>;
+
 /// Build `scene` and solve it for `steps` steps (writing frames and log to `out` when given); the simulation and
 /// the last step's reactions; an error when the last step did not converge (no gradient of an unconverged state).
 fn solve(
@@ -139,7 +142,7 @@ fn solve(
     out: Option<&Path>,
     edit: &dyn Fn(&mut Simulation),
     on_event: &mut (dyn FnMut(Event) + Send),
-) -> Result<(Simulation, Vec<(String, [f64; 3])>), WorkflowError> {
+) -> Result<(Simulation, Reactions), WorkflowError> {
     let (mut sim, tris) = scene.build(scene_arg, dir)?;
     edit(&mut sim);
     if !scene.quasi_static {
