@@ -2,7 +2,9 @@
 //! Hessian when it is not positive definite, a growing diagonal shift as the last resort; faer's sparse
 //! Cholesky with the simulation's symbolic analysis, numeric factorisation and solve run sequentially (on this
 //! 2-core machine faer's parallel supernodal factorisation spent more time handing work between threads than it
-//! saved: `basket_stretchX` took 1.5× longer with two threads than with one).
+//! saved: `basket_stretchX` took 1.5× longer with two threads than with one, the factorisation of the Newton
+//! benchmark's systems 1.3–2× longer, `docs/notes/newton-ordering.md`). The fill-reducing ordering of the symbolic
+//! analysis is chosen in [`ordering`](super::ordering).
 
 use super::ordering::{dof_permutation, nested_dissection, vertex_adjacency, FillOrdering};
 use super::Simulation;
