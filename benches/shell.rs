@@ -3,15 +3,18 @@
 //!
 //! - `triangle[<material>]/<psd>`: value, gradient and Hessian of one triangle energy (strain chain + ψ + chain
 //!   rule + projection), averaged over 64 random stencils of the derivative harness's sampler;
-//! - `newton/<triangles>`: one Newton iteration of an implicit Euler step on a 30 cm square with the default
-//!   material (parallel assembly, faer sparse Cholesky with the reused symbolic analysis, solve), and the
-//!   assembly alone.
+//! - `newton/…/<triangles>`: on a 30 cm square with the default material, for each fill-reducing ordering of
+//!   the sparse Cholesky (`[amd]` faer's minimum degree, `[nd]` nested dissection, `[auto]` the one of the two
+//!   with fewer operations, the default): `iteration[…]`, one Newton iteration of an implicit Euler step
+//!   (parallel assembly, numeric factorisation with the reused symbolic analysis, solve), and
+//!   `factor+solve[…]`, the factorisation and solve alone; and `assembly`, the assembly alone. The factor's
+//!   size and operation count are printed to stderr.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hylc::checks::shell::sample_stencil;
 use hylc::material::synthetic::default_material;
 use hylc::material::Material;
-use hylc::shell::solver::{Boundary, Settings, Simulation};
+use hylc::shell::solver::{Boundary, FillOrdering, Settings, Simulation};
 use hylc::shell::{ElementModel, Mesh, ModelFlags, Psd};
 use rand::SeedableRng;
 use std::hint::black_box;
@@ -98,11 +101,27 @@ fn newton(c: &mut Criterion) {
     let mut g = c.benchmark_group("newton");
     g.sample_size(10);
     for nt in [1000, 4000, 16000, 64000] {
-        let sim = simulation(nt);
+        let mut sim = simulation(nt);
         let label = sim.stencils.len();
-        g.bench_function(format!("iteration/{label}"), |b| {
-            b.iter(|| black_box(sim.newton_direction().unwrap()))
-        });
+        for (name, ordering) in [
+            ("amd", FillOrdering::Amd),
+            ("nd", FillOrdering::NestedDissection),
+            ("auto", FillOrdering::Auto),
+        ] {
+            sim.set_fill_ordering(ordering).unwrap();
+            let (asm, gf) = sim.newton_system().unwrap();
+            let (_, shift) = sim.solve_newton_system(&asm, &gf).unwrap();
+            let (len, flops) = sim.factor_cost();
+            eprintln!(
+                "newton/{label} {name}: factor values {len}, {flops:.3e} flops, shift {shift:e}"
+            );
+            g.bench_function(format!("factor+solve[{name}]/{label}"), |b| {
+                b.iter(|| black_box(sim.solve_newton_system(&asm, &gf).unwrap()))
+            });
+            g.bench_function(format!("iteration[{name}]/{label}"), |b| {
+                b.iter(|| black_box(sim.newton_direction().unwrap()))
+            });
+        }
         g.bench_function(format!("assembly/{label}"), |b| {
             b.iter(|| {
                 black_box(hylc::shell::assemble::assemble(

@@ -61,6 +61,7 @@
 mod adjoint;
 mod integrator;
 mod linear;
+mod ordering;
 mod stepping;
 mod terms;
 
@@ -69,6 +70,7 @@ pub use stepping::strain_quantile;
 pub use adjoint::{HeldGradient, Observable, Sensitivity, Tape, TapeStep};
 pub use integrator::{bdf2_coefficients, Integrator};
 use integrator::{Anchor, History};
+pub use ordering::FillOrdering;
 
 use super::assemble::{energy, gather, Assembled, Pattern};
 use super::dissipation::{self, Wind};
@@ -78,8 +80,7 @@ pub use super::motion::Motion;
 use super::obstacle::{self, Obstacle, Proximity};
 use super::strain::NDOF;
 use super::ShellError;
-use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, SymbolicCholesky};
-use faer::Side;
+use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use terms::Lagged;
 
 /// A named set of vertices following a keyframed translation from their initial positions.
@@ -409,14 +410,8 @@ impl Simulation {
             return Err(ShellError::Mass);
         }
         let pattern = Pattern::new(&stencils, n, &constrained);
-        let symbolic = factorize_symbolic_cholesky(
-            pattern.lower.symbolic(),
-            Side::Lower,
-            Default::default(),
-            Default::default(),
-        )
-        .map_err(|source| ShellError::Symbolic { source })?;
         let x: Vec<f64> = x0.iter().flatten().copied().collect();
+        let symbolic = linear::symbolic_analysis(&pattern, &x, FillOrdering::default())?;
         if energy(&model, &stencils, &x).is_none() {
             return Err(non_finite_material(&model, &stencils, &x, None)
                 .unwrap_or(ShellError::DegenerateInitial));
@@ -859,10 +854,28 @@ impl Simulation {
     /// The first Newton direction of the next step at the current state (assembly, factorisation, solve): one
     /// Newton iteration without the line search, for benchmarks. Returns the direction and the shift used.
     pub fn newton_direction(&self) -> Result<(Vec<f64>, f64), ShellError> {
+        let (asm, gf) = self.newton_system()?;
+        self.solve_newton_system(&asm, &gf)
+    }
+
+    /// The Newton system of the next step's first iteration at the current state: the assembly (the PSD
+    /// option's and, with `exact_first`, the exact Hessian values in the pattern's order) and the gradient over
+    /// the free dofs, for benchmarks of [`solve_newton_system`](Self::solve_newton_system).
+    pub fn newton_system(&self) -> Result<(Assembled, Vec<f64>), ShellError> {
         let h = self.settings.dt;
         let (tg, _) = self.start_of_step(self.time + h, h)?;
         let (asm, g) = self.gradient_hessian(&self.x, &tg)?;
         let (gf, _) = self.free_gradient(&g);
-        self.solve(&asm.values, &asm.values_exact, &gf)
+        Ok((asm, gf))
+    }
+
+    /// The direction d = −H⁻¹ g of a Newton system from [`newton_system`](Self::newton_system) (the
+    /// factorisations and the solve of one Newton iteration) and the diagonal shift used.
+    pub fn solve_newton_system(
+        &self,
+        asm: &Assembled,
+        gf: &[f64],
+    ) -> Result<(Vec<f64>, f64), ShellError> {
+        self.solve(&asm.values, &asm.values_exact, gf)
     }
 }
