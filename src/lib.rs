@@ -17,6 +17,7 @@
 // 1. foundations
 pub mod diff;
 pub mod periodic;
+pub mod provenance;
 pub mod real;
 pub mod sparse;
 pub mod strain;

@@ -100,6 +100,8 @@ fn gradient_matches_its_check_and_writes_the_material_layout() {
         .count();
     assert!(nonzero >= 2, "{m}");
     assert!(out.join("log.jsonl").exists());
+    assert_eq!(g["provenance"]["hylc"], env!("CARGO_PKG_VERSION"));
+    assert!(out.join("provenance.json").exists());
 }
 
 #[test]

@@ -3,7 +3,7 @@
 
 use crate::arrays::to_2d;
 use crate::errors::{detached, HyError};
-use hylc::shell::scene::run;
+use hylc::shell::scene::run_with;
 use hylc::shell::solver::StepReport;
 use hylc::workflow::simulate::{prepare, Overrides};
 use numpy::{PyArray1, PyArray2};
@@ -88,11 +88,11 @@ pub fn simulate<'py>(
         let (sc, dir) = prepare(scene, &ov)?;
         let (mut sim, tris) = sc.build(scene, &dir).map_err(HyError::from)?;
         let mut log = Vec::new();
-        let summary = run(
+        let summary = run_with(
             &mut sim,
             &tris,
             sc.steps(),
-            sc.output.obj_every,
+            &sc.output,
             out.as_deref(),
             |r| log.push(r.clone()),
         )?;

@@ -23,6 +23,7 @@ pub mod obstacle;
 pub mod render;
 pub mod scene;
 pub mod solver;
+pub mod vtu;
 
 pub use element::{ElementModel, ModelFlags, Psd};
 pub use mesh::{Mesh, Stencil};

@@ -191,7 +191,9 @@ pub fn fit_samples(
     fit.material
         .save(&job.out)
         .map_err(|e| WorkflowError::io(&job.out, "cannot write", e))?;
-    let text = serde_json::to_string_pretty(&fit.report).expect("fit reports serialise");
+    let mut value = serde_json::to_value(&fit.report).expect("fit reports serialise");
+    value["provenance"] = crate::provenance::Provenance::now().to_json();
+    let text = serde_json::to_string_pretty(&value).expect("a JSON value serialises");
     write_file(&job.report, text + "\n")?;
 
     for line in report_lines(samples, &fit.report, job.compare.as_deref()) {

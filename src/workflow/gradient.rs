@@ -13,7 +13,7 @@ use super::{write_file, Event, WorkflowError};
 use crate::material::coefficients::Coefficient;
 use crate::shell::mesh::load_obj_surface;
 use crate::shell::motion::Motion;
-use crate::shell::scene::{run, Scene};
+use crate::shell::scene::{run_with, Scene};
 use crate::shell::solver::{Observable, Sensitivity, Simulation};
 use crate::shell::ShellError;
 use serde_json::{json, Value};
@@ -149,7 +149,7 @@ fn solve(
         sim.start_tape();
     }
     let mut done = 0;
-    let summary = run(&mut sim, &tris, steps, scene.output.obj_every, out, |r| {
+    let summary = run_with(&mut sim, &tris, steps, &scene.output, out, |r| {
         done += 1;
         on_event(Event::Step {
             done,
@@ -279,6 +279,7 @@ fn to_json(
             "difference": r.difference,
             "error": r.error,
         })).collect::<Vec<_>>(),
+        "provenance": crate::provenance::Provenance::now().to_json(),
     })
 }
 

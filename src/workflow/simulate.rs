@@ -3,7 +3,7 @@
 
 use super::{Event, WorkflowError};
 use crate::shell::render::{write_png, Layer, View};
-use crate::shell::scene::{run, MeshSpec, RunSummary, Scene};
+use crate::shell::scene::{run_with, MeshSpec, RunSummary, Scene};
 use crate::shell::{Psd, ShellError};
 use std::path::{Path, PathBuf};
 
@@ -26,6 +26,8 @@ pub struct Overrides {
     pub no_bending: bool,
     pub only_1d: bool,
     pub in_plane_only: bool,
+    /// also a `.vtu` frame (ψ and the strain per triangle) beside each OBJ, `output.vtu`
+    pub vtu: bool,
 }
 
 /// The scene `scene_arg` (a JSON file or a built-in) after the overrides, with the folder its relative paths
@@ -103,6 +105,7 @@ pub fn prepare_noted(
     scene.model.bending &= !ov.no_bending;
     scene.model.only_1d |= ov.only_1d;
     scene.model.in_plane_only |= ov.in_plane_only;
+    scene.output.vtu |= ov.vtu;
     Ok((scene, dir))
 }
 
@@ -137,23 +140,16 @@ pub fn execute(
         out.display()
     )));
     let mut done = 0;
-    let summary = run(
-        &mut sim,
-        &tris,
-        steps,
-        scene.output.obj_every,
-        Some(out),
-        |r| {
-            done += 1;
-            on_event(Event::Step {
-                done,
-                total: steps,
-                time: r.time,
-                newton: r.newton,
-                residual: r.residual,
-            });
-        },
-    )?;
+    let summary = run_with(&mut sim, &tris, steps, &scene.output, Some(out), |r| {
+        done += 1;
+        on_event(Event::Step {
+            done,
+            total: steps,
+            time: r.time,
+            newton: r.newton,
+            residual: r.residual,
+        });
+    })?;
     Ok(Outcome {
         summary,
         positions: sim.positions(),

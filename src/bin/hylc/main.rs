@@ -29,10 +29,18 @@ mod validate;
 mod yarn;
 
 use clap::{Parser, Subcommand};
+
+/// `hylc --version`: the version and the commit it was built from.
+const VERSION: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (commit ",
+    env!("HYLC_COMMIT"),
+    ")"
+);
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "hylc", version, about = "Homogenized yarn-level cloth")]
+#[command(name = "hylc", version = VERSION, about = "Homogenized yarn-level cloth")]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -13,7 +13,8 @@ use std::process::ExitCode;
 
 /// Simulate a cloth scene: a scene JSON file, an ARCSim-HYLC scene file (converted; warnings name the keys it
 /// ignores) or a built-in (stretch-x, stretch-y, drape-x, drape-y, hanging).
-/// Writes frame_NNNN.obj per frame and log.jsonl (one JSON object per step) to the output folder. Exit code 0:
+/// Writes frame_NNNN.obj per frame, log.jsonl (one JSON object per step), handle_forces.csv and provenance.json
+/// (version, commit, command line) to the output folder. Exit code 0:
 /// complete (every step converged); 2: bad input; 3: did not converge (a step failed even with its time step
 /// halved `solver.max_halvings` times, or a residual or energy became non-finite; the run stops there and keeps
 /// what it wrote).
@@ -60,6 +61,9 @@ pub struct Args {
     /// use only the in-plane terms of the material (implies no bending)
     #[arg(long)]
     in_plane_only: bool,
+    /// also write frame_NNNN.vtu beside each OBJ: ψ and the six strains per triangle, for ParaView
+    #[arg(long)]
+    vtu: bool,
     /// no progress bar
     #[arg(long)]
     quiet: bool,
@@ -118,6 +122,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         no_bending: a.no_bending,
         only_1d: a.only_1d,
         in_plane_only: a.in_plane_only,
+        vtu: a.vtu,
     };
     let mut printer = Printer::new(a.quiet);
     let (scene, dir) = prepare_noted(&a.scene, &ov, &mut |e| printer.show(e))?;

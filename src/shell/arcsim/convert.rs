@@ -77,7 +77,7 @@ pub(super) fn convert(root: &Node, ctx: &mut Ctx, name: &str) -> Result<Scene, S
             friction,
             ..contact_default
         },
-        output: OutputSpec { obj_every: 1 },
+        output: OutputSpec::default(),
     })
 }
 

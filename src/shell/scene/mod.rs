@@ -34,7 +34,7 @@
 //!                 {"plane": {"point": [0, 0, -0.5], "normal": [0, 0, 1]}},
 //!                 {"mesh": {"path": "sphere.obj", "transform": {"scale": 0.03, "translate": [0, 0, -0.04]}}}],
 //!   "contact": {"thickness": 0.002, "stiffness": 1e8, "friction": 0.0, "friction_velocity": 1e-3},
-//!   "output": {"obj_every": 1}
+//!   "output": {"obj_every": 1, "vtu": false}
 //! }
 //! ```
 //! Selections are in rest-layout (mesh-plane) coordinates, metres; `{"ball": {"center": [x, y, z], "radius": r}}`
@@ -372,11 +372,17 @@ impl Default for ContactSpec {
 pub struct OutputSpec {
     /// write an OBJ every this many frames (0: none)
     pub obj_every: usize,
+    /// also a `.vtu` beside each OBJ frame, with ψ and the strain per triangle (`shell::vtu`)
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub vtu: bool,
 }
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        OutputSpec { obj_every: 1 }
+        OutputSpec {
+            obj_every: 1,
+            vtu: false,
+        }
     }
 }
 
@@ -549,4 +555,4 @@ mod run;
 mod validate;
 
 pub use builtin::{builtin, BUILTINS, BUILTIN_EDGE, SIDE};
-pub use run::{run, RunSummary};
+pub use run::{run, run_with, RunSummary};

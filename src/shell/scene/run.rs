@@ -16,15 +16,33 @@ pub struct RunSummary {
     pub last: Option<StepReport>,
 }
 
-/// Run a built simulation for `steps` steps, writing `frame_NNNN.obj` (frame 0 the initial state) every
-/// `obj_every` steps, one JSON line per step to `log.jsonl` and, when the scene holds vertices, the reaction
-/// of every held set per step to `handle_forces.csv` (columns `time`, then `NAME_fx`, `NAME_fy`, `NAME_fz`,
-/// `NAME_norm` per set, N) in `out` (when given). `progress` is called after every step.
+/// [`run_with`] writing OBJ frames only, every `obj_every` steps (0: none).
 pub fn run(
     sim: &mut Simulation,
     tris: &[[usize; 3]],
     steps: usize,
     obj_every: usize,
+    out: Option<&Path>,
+    progress: impl FnMut(&StepReport),
+) -> Result<RunSummary, ShellError> {
+    let output = OutputSpec {
+        obj_every,
+        vtu: false,
+    };
+    run_with(sim, tris, steps, &output, out, progress)
+}
+
+/// Run a built simulation for `steps` steps, writing to `out` (when given): `frame_NNNN.obj` (frame 0 the initial
+/// state) every `output.obj_every` steps (and `frame_NNNN.vtu` beside it with `output.vtu`,
+/// [`crate::shell::vtu`]), `provenance.json` (hylc's version and commit, the command line), one JSON line per
+/// step to `log.jsonl` and, when the scene holds vertices, the reaction of every held set per step to
+/// `handle_forces.csv` (columns `time`, then `NAME_fx`, `NAME_fy`, `NAME_fz`, `NAME_norm` per set, N).
+/// `progress` is called after every step.
+pub fn run_with(
+    sim: &mut Simulation,
+    tris: &[[usize; 3]],
+    steps: usize,
+    output: &OutputSpec,
     out: Option<&Path>,
     mut progress: impl FnMut(&StepReport),
 ) -> Result<RunSummary, ShellError> {
@@ -50,9 +68,13 @@ pub fn run(
         Some(dir) => {
             std::fs::create_dir_all(dir)
                 .map_err(|e| ShellError::io(dir, "cannot create the folder", e))?;
-            if obj_every > 0 {
-                let f = dir.join("frame_0000.obj");
-                write_obj(&f, &sim.positions(), tris).map_err(|e| io(e, &f))?;
+            let f = dir.join("provenance.json");
+            let text =
+                serde_json::to_string_pretty(&crate::provenance::Provenance::now().to_json())
+                    .expect("a JSON value serialises");
+            std::fs::write(&f, text).map_err(|e| io(e, &f))?;
+            if output.obj_every > 0 {
+                write_frame(sim, tris, dir, 0, output.vtu).map_err(|(e, f)| io(e, &f))?;
             }
             let f = dir.join("log.jsonl");
             Some((
@@ -91,9 +113,8 @@ pub fn run(
                 }
                 writeln!(w, "{row}").map_err(|e| io(e, f))?;
             }
-            if obj_every > 0 && k % obj_every == 0 {
-                let f = dir.join(format!("frame_{k:04}.obj"));
-                write_obj(&f, &sim.positions(), tris).map_err(|e| io(e, &f))?;
+            if output.obj_every > 0 && k % output.obj_every == 0 {
+                write_frame(sim, tris, dir, k, output.vtu).map_err(|(e, f)| io(e, &f))?;
             }
         }
         progress(&r);
@@ -104,4 +125,21 @@ pub fn run(
     }
     sum.wall = start.elapsed().as_secs_f64();
     Ok(sum)
+}
+
+/// Frame `k`: `frame_k.obj`, and `frame_k.vtu` with `vtu`; the error with the file it was about.
+fn write_frame(
+    sim: &Simulation,
+    tris: &[[usize; 3]],
+    dir: &Path,
+    k: usize,
+    vtu: bool,
+) -> Result<(), (std::io::Error, std::path::PathBuf)> {
+    let f = dir.join(format!("frame_{k:04}.obj"));
+    write_obj(&f, &sim.positions(), tris).map_err(|e| (e, f))?;
+    if vtu {
+        let f = dir.join(format!("frame_{k:04}.vtu"));
+        sim.write_vtu(&f, tris).map_err(|e| (e, f))?;
+    }
+    Ok(())
 }
