@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 
 /// The crate's top-level modules from the bottom layer up (the order of `src/lib.rs`).
 const ORDER: &[&str] = &[
+    "provenance",
     "sparse",
     "strain",
     "real",
