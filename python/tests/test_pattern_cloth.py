@@ -155,7 +155,7 @@ def test_gradient_equals_the_cli_and_the_vjp_equals_a_target(tmp_path, cli):
     with pytest.raises(ValueError, match="cotangent"):
         hylc.gradient(scene, cotangent=np.zeros((3, 3)))
     damped = json.loads(open(scene).read())
-    damped.update(quasi_static=False, damping=0.01, duration=1 / 60)
+    damped.update(quasi_static=False, damping=0.01, dt=1 / 60, duration=1 / 60)
     (tmp_path / "damped.json").write_text(json.dumps(damped))
     with pytest.raises(ValueError, match="damping"):
         hylc.gradient(str(tmp_path / "damped.json"), observable="energy")
