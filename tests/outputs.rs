@@ -1,6 +1,7 @@
 //! What a run leaves for other tools (docs/cloth-simulator.md, "Outputs"): `provenance.json` beside the frames
-//! (hylc's version, the commit, the command line), `.vtu` frames with ψ and the six strains per triangle when
-//! asked for, and `hylc --version` naming the commit.
+//! (hylc's version, the commit, the command line) and the same in every OBJ's header, `.vtu` frames with ψ and
+//! the six strains per triangle and the velocity per vertex with their series `frames.pvd` when asked for, and
+//! `hylc --version` naming the commit. (The Python tests read the series back with meshio.)
 
 use serde_json::Value;
 use std::process::Command;
@@ -40,7 +41,8 @@ fn simulate_writes_provenance_and_vtu_frames() {
         "0.025",
         "--duration",
         "0.0334",
-        "--vtu",
+        "--format",
+        "vtu",
         "--quiet",
         "--out",
         o,
@@ -59,8 +61,15 @@ fn simulate_writes_provenance_and_vtu_frames() {
         .map(|v| v.as_str().unwrap())
         .collect();
     assert_eq!(&command[1..], &args[..]);
+    let pvd = std::fs::read_to_string(out.join("frames.pvd")).unwrap();
+    assert!(
+        pvd.contains("timestep=\"0\" group=\"\" part=\"0\" file=\"frame_0000.vtu\""),
+        "{pvd}"
+    );
     for k in 0..=2 {
-        assert!(out.join(format!("frame_{k:04}.obj")).exists());
+        let obj = std::fs::read_to_string(out.join(format!("frame_{k:04}.obj"))).unwrap();
+        assert!(obj.starts_with(&format!("# hylc {}", env!("CARGO_PKG_VERSION"))), "{obj}");
+        assert!(obj.contains("simulate stretch-x"));
         let text = std::fs::read_to_string(out.join(format!("frame_{k:04}.vtu"))).unwrap();
         let cells: usize = {
             let s = text.find("NumberOfCells=\"").unwrap() + 15;
@@ -68,6 +77,11 @@ fn simulate_writes_provenance_and_vtu_frames() {
         };
         let psi = array(&text, "psi");
         let strain = array(&text, "strain");
+        let points = text.matches('\n').count(); // an upper bound; the exact count below
+        let s = text.find("NumberOfPoints=\"").unwrap() + 16;
+        let n: usize = text[s..s + text[s..].find('"').unwrap()].parse().unwrap();
+        assert!(n < points);
+        assert_eq!(array(&text, "velocity").len(), 3 * n);
         assert_eq!(psi.len(), cells);
         assert_eq!(strain.len(), 6 * cells);
         assert!(psi.iter().all(|v| v.is_finite()));

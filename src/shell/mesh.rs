@@ -371,10 +371,18 @@ impl Mesh {
     }
 }
 
-/// Write positions and triangles as an OBJ file.
-pub fn write_obj(path: &Path, x: &[[f64; 3]], tris: &[[usize; 3]]) -> std::io::Result<()> {
+/// Write positions and triangles as an OBJ file, each line of `header` first as a comment.
+pub fn write_obj(
+    path: &Path,
+    header: &str,
+    x: &[[f64; 3]],
+    tris: &[[usize; 3]],
+) -> std::io::Result<()> {
     use std::io::Write;
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    for line in header.lines() {
+        writeln!(f, "# {line}")?;
+    }
     for p in x {
         writeln!(f, "v {} {} {}", p[0], p[1], p[2])?;
     }

@@ -1,8 +1,10 @@
-//! Frames as VTK unstructured grids (`.vtu`, ASCII XML) that ParaView and VisIt open: the triangles with
-//! per-triangle fields, so that a frame can be coloured by its energy density or any strain component.
+//! Frames as VTK unstructured grids (`.vtu`, ASCII XML) that ParaView and VisIt open, and the series of a run as
+//! a ParaView collection (`.pvd`: every frame with its time), so that a run can be played and coloured by its
+//! energy density, any strain component or the velocity.
 //!
 //! Cell data of [`Simulation::triangle_fields`]: `psi` = E_Δ / A (J/m², the triangle's energy per rest area,
-//! barriers included) and `strain` (6 components: s_x, s_a, s_y, II₀₀, II₀₁, II₁₁, `docs/cloth-simulator.md`).
+//! barriers included) and `strain` (6 components: s_x, s_a, s_y, II₀₀, II₀₁, II₁₁, `docs/cloth-simulator.md`);
+//! point data `velocity` (m/s).
 
 use super::solver::Simulation;
 use super::strain::StrainChain;
@@ -10,19 +12,20 @@ use crate::shell::assemble::gather;
 use std::io::Write;
 use std::path::Path;
 
-/// A named per-triangle field with `components` numbers per triangle.
+/// A named field with `components` numbers per triangle (cell data) or per vertex (point data).
 pub struct CellField<'a> {
     pub name: &'a str,
     pub components: usize,
     pub values: &'a [f64],
 }
 
-/// Write `x` and `tris` with the cell fields as a `.vtu` file.
+/// Write `x` and `tris` with the cell fields and the point fields as a `.vtu` file.
 pub fn write_vtu(
     path: &Path,
     x: &[[f64; 3]],
     tris: &[[usize; 3]],
     fields: &[CellField],
+    point_fields: &[CellField],
 ) -> std::io::Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
     writeln!(f, "<?xml version=\"1.0\"?>")?;
@@ -72,21 +75,42 @@ pub fn write_vtu(
     }
     writeln!(f, "</DataArray>")?;
     writeln!(f, "</Cells>")?;
-    writeln!(f, "<CellData>")?;
-    for c in fields {
-        writeln!(
-            f,
-            "<DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">",
-            c.name, c.components
-        )?;
-        for row in c.values.chunks(c.components) {
-            let row: Vec<String> = row.iter().map(|v| v.to_string()).collect();
-            writeln!(f, "{}", row.join(" "))?;
+    for (tag, list) in [("CellData", fields), ("PointData", point_fields)] {
+        writeln!(f, "<{tag}>")?;
+        for c in list {
+            write_array(&mut f, c)?;
         }
-        writeln!(f, "</DataArray>")?;
+        writeln!(f, "</{tag}>")?;
     }
-    writeln!(f, "</CellData>")?;
     writeln!(f, "</Piece></UnstructuredGrid></VTKFile>")?;
+    f.flush()
+}
+
+/// One `<DataArray>` of a field, a row per triangle or vertex.
+fn write_array(f: &mut impl Write, c: &CellField) -> std::io::Result<()> {
+    writeln!(
+        f,
+        "<DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"ascii\">",
+        c.name, c.components
+    )?;
+    for row in c.values.chunks(c.components) {
+        let row: Vec<String> = row.iter().map(|v| v.to_string()).collect();
+        writeln!(f, "{}", row.join(" "))?;
+    }
+    writeln!(f, "</DataArray>")
+}
+
+/// Write a ParaView collection of `(time, file)` frames (file names relative to the collection's folder).
+pub fn write_pvd(path: &Path, frames: &[(f64, String)]) -> std::io::Result<()> {
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(f, "<?xml version=\"1.0\"?>")?;
+    writeln!(f, "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">")?;
+    writeln!(f, "<Collection>")?;
+    for (t, file) in frames {
+        writeln!(f, "<DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{file}\"/>")?;
+    }
+    writeln!(f, "</Collection>")?;
+    writeln!(f, "</VTKFile>")?;
     f.flush()
 }
 
@@ -113,7 +137,7 @@ impl Simulation {
         (psi, z)
     }
 
-    /// Write the current state as a `.vtu` frame with `psi` and `strain` per triangle.
+    /// Write the current state as a `.vtu` frame with `psi` and `strain` per triangle and `velocity` per vertex.
     pub fn write_vtu(&self, path: &Path, tris: &[[usize; 3]]) -> std::io::Result<()> {
         let (psi, z) = self.triangle_fields();
         let fields = [
@@ -128,7 +152,12 @@ impl Simulation {
                 values: &z,
             },
         ];
-        write_vtu(path, &self.positions(), tris, &fields)
+        let velocity = [CellField {
+            name: "velocity",
+            components: 3,
+            values: &self.v,
+        }];
+        write_vtu(path, &self.positions(), tris, &fields, &velocity)
     }
 }
 
@@ -150,7 +179,13 @@ mod tests {
             components: 1,
             values: &psi,
         }];
-        write_vtu(&f, &x, &tris, &fields).unwrap();
+        let v = [0.0, 0.0, 1.0].repeat(4);
+        let vel = [CellField {
+            name: "velocity",
+            components: 3,
+            values: &v,
+        }];
+        write_vtu(&f, &x, &tris, &fields, &vel).unwrap();
         let text = std::fs::read_to_string(&f).unwrap();
         assert!(text.contains("NumberOfPoints=\"4\" NumberOfCells=\"2\""));
         assert!(text.contains("Name=\"offsets\" format=\"ascii\">\n3\n6\n</DataArray>"));
@@ -159,5 +194,10 @@ mod tests {
             text.contains("Name=\"psi\" NumberOfComponents=\"1\" format=\"ascii\">\n0.5\n1.5\n")
         );
         assert!(text.contains("1 3 2\n"));
+        assert!(text.contains("<PointData>\n<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\""));
+        let pvd = dir.join("t.pvd");
+        write_pvd(&pvd, &[(0.0, "a.vtu".into()), (0.5, "b.vtu".into())]).unwrap();
+        let text = std::fs::read_to_string(&pvd).unwrap();
+        assert!(text.contains("<DataSet timestep=\"0.5\" group=\"\" part=\"0\" file=\"b.vtu\"/>"));
     }
 }

@@ -61,9 +61,10 @@ pub struct Args {
     /// use only the in-plane terms of the material (implies no bending)
     #[arg(long)]
     in_plane_only: bool,
-    /// also write frame_NNNN.vtu beside each OBJ: ψ and the six strains per triangle, for ParaView
-    #[arg(long)]
-    vtu: bool,
+    /// frames: obj (frame_NNNN.obj), or vtu (also frame_NNNN.vtu beside each OBJ with ψ and the six strains per
+    /// triangle and the velocity per vertex, and the ParaView series frames.pvd with their times)
+    #[arg(long, value_enum, default_value = "obj")]
+    format: FormatArg,
     /// no progress bar
     #[arg(long)]
     quiet: bool,
@@ -71,6 +72,13 @@ pub struct Args {
     /// paths relative to its folder: save it there)
     #[arg(long)]
     print: bool,
+}
+
+/// The frames' format.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum FormatArg {
+    Obj,
+    Vtu,
 }
 
 /// The scheme of a substep (`hylc::shell::solver::Integrator`).
@@ -122,7 +130,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         no_bending: a.no_bending,
         only_1d: a.only_1d,
         in_plane_only: a.in_plane_only,
-        vtu: a.vtu,
+        vtu: matches!(a.format, FormatArg::Vtu),
     };
     let mut printer = Printer::new(a.quiet);
     let (scene, dir) = prepare_noted(&a.scene, &ov, &mut |e| printer.show(e))?;

@@ -33,7 +33,8 @@ pub fn run(
 }
 
 /// Run a built simulation for `steps` steps, writing to `out` (when given): `frame_NNNN.obj` (frame 0 the initial
-/// state) every `output.obj_every` steps (and `frame_NNNN.vtu` beside it with `output.vtu`,
+/// state, a comment header with hylc's version, commit, command line and the frame's time) every
+/// `output.obj_every` steps (and `frame_NNNN.vtu` beside it and the series `frames.pvd` with `output.vtu`,
 /// [`crate::shell::vtu`]), `provenance.json` (hylc's version and commit, the command line), one JSON line per
 /// step to `log.jsonl` and, when the scene holds vertices, the reaction of every held set per step to
 /// `handle_forces.csv` (columns `time`, then `NAME_fx`, `NAME_fy`, `NAME_fz`, `NAME_norm` per set, N).
@@ -47,6 +48,7 @@ pub fn run_with(
     mut progress: impl FnMut(&StepReport),
 ) -> Result<RunSummary, ShellError> {
     let io = |e: std::io::Error, what: &Path| ShellError::io(what, "cannot write", e);
+    let mut frames = Frames::new(output.vtu);
     let mut forces = match out {
         Some(dir) if sim.held_set_names().next().is_some() => {
             let f = dir.join("handle_forces.csv");
@@ -74,7 +76,7 @@ pub fn run_with(
                     .expect("a JSON value serialises");
             std::fs::write(&f, text).map_err(|e| io(e, &f))?;
             if output.obj_every > 0 {
-                write_frame(sim, tris, dir, 0, output.vtu).map_err(|(e, f)| io(e, &f))?;
+                frames.write(sim, tris, dir, 0).map_err(|(e, f)| io(e, &f))?;
             }
             let f = dir.join("log.jsonl");
             Some((
@@ -114,7 +116,7 @@ pub fn run_with(
                 writeln!(w, "{row}").map_err(|e| io(e, f))?;
             }
             if output.obj_every > 0 && k % output.obj_every == 0 {
-                write_frame(sim, tris, dir, k, output.vtu).map_err(|(e, f)| io(e, &f))?;
+                frames.write(sim, tris, dir, k).map_err(|(e, f)| io(e, &f))?;
             }
         }
         progress(&r);
@@ -127,19 +129,49 @@ pub fn run_with(
     Ok(sum)
 }
 
-/// Frame `k`: `frame_k.obj`, and `frame_k.vtu` with `vtu`; the error with the file it was about.
-fn write_frame(
-    sim: &Simulation,
-    tris: &[[usize; 3]],
-    dir: &Path,
-    k: usize,
+/// The frames of a run: `frame_k.obj` with a provenance header, and with `vtu` also `frame_k.vtu` and the
+/// collection `frames.pvd` of every VTU so far with its time (rewritten after each frame, so that a run that
+/// stops early leaves a valid series).
+struct Frames {
     vtu: bool,
-) -> Result<(), (std::io::Error, std::path::PathBuf)> {
-    let f = dir.join(format!("frame_{k:04}.obj"));
-    write_obj(&f, &sim.positions(), tris).map_err(|e| (e, f))?;
-    if vtu {
-        let f = dir.join(format!("frame_{k:04}.vtu"));
-        sim.write_vtu(&f, tris).map_err(|e| (e, f))?;
+    header: String,
+    series: Vec<(f64, String)>,
+}
+
+impl Frames {
+    fn new(vtu: bool) -> Frames {
+        let p = crate::provenance::Provenance::now();
+        Frames {
+            vtu,
+            header: format!(
+                "hylc {} (commit {}): {}",
+                p.hylc,
+                p.commit,
+                p.command.join(" ")
+            ),
+            series: vec![],
+        }
     }
-    Ok(())
+
+    /// Frame `k` of the current state; the error with the file it was about.
+    fn write(
+        &mut self,
+        sim: &Simulation,
+        tris: &[[usize; 3]],
+        dir: &Path,
+        k: usize,
+    ) -> Result<(), (std::io::Error, std::path::PathBuf)> {
+        let f = dir.join(format!("frame_{k:04}.obj"));
+        let header = format!("{}\nt = {} s", self.header, sim.time);
+        write_obj(&f, &header, &sim.positions(), tris).map_err(|e| (e, f))?;
+        if self.vtu {
+            let name = format!("frame_{k:04}.vtu");
+            let f = dir.join(&name);
+            sim.write_vtu(&f, tris).map_err(|e| (e, f))?;
+            self.series.push((sim.time, name));
+            let f = dir.join("frames.pvd");
+            crate::shell::vtu::write_pvd(&f, &self.series).map_err(|e| (e, f))?;
+        }
+        Ok(())
+    }
 }
