@@ -68,7 +68,10 @@ fn simulate_writes_provenance_and_vtu_frames() {
     );
     for k in 0..=2 {
         let obj = std::fs::read_to_string(out.join(format!("frame_{k:04}.obj"))).unwrap();
-        assert!(obj.starts_with(&format!("# hylc {}", env!("CARGO_PKG_VERSION"))), "{obj}");
+        assert!(
+            obj.starts_with(&format!("# hylc {}", env!("CARGO_PKG_VERSION"))),
+            "{obj}"
+        );
         assert!(obj.contains("simulate stretch-x"));
         let text = std::fs::read_to_string(out.join(format!("frame_{k:04}.vtu"))).unwrap();
         let cells: usize = {

@@ -104,10 +104,16 @@ fn write_array(f: &mut impl Write, c: &CellField) -> std::io::Result<()> {
 pub fn write_pvd(path: &Path, frames: &[(f64, String)]) -> std::io::Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
     writeln!(f, "<?xml version=\"1.0\"?>")?;
-    writeln!(f, "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">")?;
+    writeln!(
+        f,
+        "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">"
+    )?;
     writeln!(f, "<Collection>")?;
     for (t, file) in frames {
-        writeln!(f, "<DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{file}\"/>")?;
+        writeln!(
+            f,
+            "<DataSet timestep=\"{t}\" group=\"\" part=\"0\" file=\"{file}\"/>"
+        )?;
     }
     writeln!(f, "</Collection>")?;
     writeln!(f, "</VTKFile>")?;
@@ -194,7 +200,9 @@ mod tests {
             text.contains("Name=\"psi\" NumberOfComponents=\"1\" format=\"ascii\">\n0.5\n1.5\n")
         );
         assert!(text.contains("1 3 2\n"));
-        assert!(text.contains("<PointData>\n<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\""));
+        assert!(text.contains(
+            "<PointData>\n<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\""
+        ));
         let pvd = dir.join("t.pvd");
         write_pvd(&pvd, &[(0.0, "a.vtu".into()), (0.5, "b.vtu".into())]).unwrap();
         let text = std::fs::read_to_string(&pvd).unwrap();

@@ -76,7 +76,9 @@ pub fn run_with(
                     .expect("a JSON value serialises");
             std::fs::write(&f, text).map_err(|e| io(e, &f))?;
             if output.obj_every > 0 {
-                frames.write(sim, tris, dir, 0).map_err(|(e, f)| io(e, &f))?;
+                frames
+                    .write(sim, tris, dir, 0)
+                    .map_err(|(e, f)| io(e, &f))?;
             }
             let f = dir.join("log.jsonl");
             Some((
@@ -116,7 +118,9 @@ pub fn run_with(
                 writeln!(w, "{row}").map_err(|e| io(e, f))?;
             }
             if output.obj_every > 0 && k % output.obj_every == 0 {
-                frames.write(sim, tris, dir, k).map_err(|(e, f)| io(e, &f))?;
+                frames
+                    .write(sim, tris, dir, k)
+                    .map_err(|(e, f)| io(e, &f))?;
             }
         }
         progress(&r);
