@@ -175,7 +175,7 @@ def test_vtu_series_reads_back_with_meshio(tmp_path, cli):
     for d in sets:
         m = meshio.read(out / d.get("file"))
         tri = m.cells_dict["triangle"]
-        assert m.cell_data["psi"][0].shape == (len(tri),)
+        assert np.asarray(m.cell_data["psi"][0]).reshape(len(tri), -1).shape == (len(tri), 1)
         assert m.cell_data["strain"][0].shape == (len(tri), 6)
         assert m.point_data["velocity"].shape == (len(m.points), 3)
         obj = _obj_vertices(out / d.get("file").replace(".vtu", ".obj"))
