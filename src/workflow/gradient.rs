@@ -9,11 +9,12 @@
 //! (elastic), `handle-force:NAME:x|y|z` (the reaction of a held set, as `handle_forces.csv` reports it),
 //! `target:FILE.obj` (½ Σ_v |x_v − x̂_v|² against an OBJ with the scene's vertices).
 
+use super::simulate::run_reporting;
 use super::{write_file, Event, WorkflowError};
 use crate::material::coefficients::Coefficient;
 use crate::shell::mesh::load_obj_surface;
 use crate::shell::motion::Motion;
-use crate::shell::scene::{run_with, Scene};
+use crate::shell::scene::Scene;
 use crate::shell::solver::{Observable, Sensitivity, Simulation};
 use crate::shell::ShellError;
 use serde_json::{json, Value};
@@ -148,17 +149,7 @@ fn solve(
     if !scene.quasi_static {
         sim.start_tape();
     }
-    let mut done = 0;
-    let summary = run_with(&mut sim, &tris, steps, &scene.output, out, |r| {
-        done += 1;
-        on_event(Event::Step {
-            done,
-            total: steps,
-            time: r.time,
-            newton: r.newton,
-            residual: r.residual,
-        });
-    })?;
+    let summary = run_reporting(&mut sim, &tris, steps, &scene.output, out, on_event)?;
     match summary.last {
         Some(r) if !r.converged => Err(WorkflowError::NoGradient(format!(
             "{scene_arg}: the step at t = {:.4} s did not converge (residual {:.2e} N): no gradient of an \

@@ -139,8 +139,26 @@ pub fn execute(
         if scene.quasi_static { " (quasi-static)" } else { "" },
         out.display()
     )));
+    let summary = run_reporting(&mut sim, &tris, steps, &scene.output, Some(out), on_event)?;
+    Ok(Outcome {
+        summary,
+        positions: sim.positions(),
+        triangles: tris,
+        obstacles: sim.obstacle_surfaces(),
+    })
+}
+
+/// [`run_with`] reporting every step as an [`Event::Step`].
+pub(crate) fn run_reporting(
+    sim: &mut crate::shell::solver::Simulation,
+    tris: &[[usize; 3]],
+    steps: usize,
+    output: &crate::shell::scene::OutputSpec,
+    out: Option<&Path>,
+    on_event: &mut (dyn FnMut(Event) + Send),
+) -> Result<RunSummary, ShellError> {
     let mut done = 0;
-    let summary = run_with(&mut sim, &tris, steps, &scene.output, Some(out), |r| {
+    run_with(sim, tris, steps, output, out, |r| {
         done += 1;
         on_event(Event::Step {
             done,
@@ -149,12 +167,6 @@ pub fn execute(
             newton: r.newton,
             residual: r.residual,
         });
-    })?;
-    Ok(Outcome {
-        summary,
-        positions: sim.positions(),
-        triangles: tris,
-        obstacles: sim.obstacle_surfaces(),
     })
 }
 

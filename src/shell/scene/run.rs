@@ -71,9 +71,8 @@ pub fn run_with(
             std::fs::create_dir_all(dir)
                 .map_err(|e| ShellError::io(dir, "cannot create the folder", e))?;
             let f = dir.join("provenance.json");
-            let text =
-                serde_json::to_string_pretty(&crate::provenance::Provenance::now().to_json())
-                    .expect("a JSON value serialises");
+            let text = serde_json::to_string_pretty(&frames.provenance.to_json())
+                .expect("a JSON value serialises");
             std::fs::write(&f, text).map_err(|e| io(e, &f))?;
             if output.obj_every > 0 {
                 frames
@@ -138,6 +137,8 @@ pub fn run_with(
 /// stops early leaves a valid series).
 struct Frames {
     vtu: bool,
+    /// the run's provenance record (also `provenance.json`)
+    provenance: crate::provenance::Provenance,
     header: String,
     series: Vec<(f64, String)>,
 }
@@ -153,6 +154,7 @@ impl Frames {
                 p.commit,
                 p.command.join(" ")
             ),
+            provenance: p,
             series: vec![],
         }
     }
