@@ -1,4 +1,4 @@
-//! ARCSim-HYLC scene files (issue 18, Deliver 1): the conversion of every honoured key on a synthetic scene
+//! ARCSim-HYLC scene files: the conversion of every honoured key on a synthetic scene
 //! (handlebar strips as exact vertex sets per side, handlespheres, motions, defaults), one warning per ignored or
 //! unknown key, one-line errors naming file and key (exit code 2 from the CLI), `--print` giving a scene that runs
 //! bitwise like the original file, and the original's 42 scenes converting and building (skipped without
@@ -285,6 +285,12 @@ fn defaults_are_arcsims() {
     assert_eq!(s.contact.friction, 0.3);
     assert_eq!(s.gravity, [0.0; 3]);
     assert_eq!(s.damping, 0.0);
+    // implicit Euler with substeps chosen by accuracy (docs/time-study.md)
+    assert_eq!(s.solver.time_tol, Some(1e-4));
+    assert_eq!(
+        s.solver.integrator,
+        hylc::shell::solver::Integrator::ImplicitEuler
+    );
     assert!(!s.model.only_1d);
     assert!(s.handles.is_empty() && s.pins.is_empty() && s.obstacles.is_empty());
     assert!(c.warnings.is_empty(), "{:?}", c.warnings);
@@ -299,6 +305,42 @@ fn defaults_are_arcsims() {
         )
         .unwrap();
     assert_eq!((c.scene.wind.density, c.scene.wind.drag), (1.0, 2.0));
+}
+
+/// `--time-tol off` (`TimeTol::Off`) takes the conversion's `time_tol` away, a length replaces it, and anything else
+/// is an error naming the value.
+#[test]
+fn time_tol_override_turns_the_conversions_off_or_replaces_it() {
+    use hylc::workflow::simulate::{prepare, Overrides, TimeTol};
+    let f = Fixture::new("timetol");
+    let text = r#"{"hylc": {"material": "mats/m.json"}, "frame_time": 0.02, "end_time": 1,
+        "cloths": [{"mesh": "meshes/grid.obj", "materials": [{}]}]}"#;
+    let path = f.scene("timetol", text);
+    let arg = path.to_str().unwrap();
+    let with = |t: Option<TimeTol>| {
+        let ov = Overrides {
+            time_tol: t,
+            ..Default::default()
+        };
+        prepare(arg, &ov).unwrap().0.solver.time_tol
+    };
+    assert_eq!(with(None), Some(1e-4));
+    assert_eq!(with(Some(TimeTol::Off)), None);
+    assert_eq!(with(Some(TimeTol::Metres(2e-5))), Some(2e-5));
+    assert_eq!("off".parse::<TimeTol>(), Ok(TimeTol::Off));
+    assert_eq!("3e-5".parse::<TimeTol>(), Ok(TimeTol::Metres(3e-5)));
+    for bad in ["0", "-1e-4", "NaN", "inf", "of"] {
+        let e = bad.parse::<TimeTol>().unwrap_err();
+        assert!(e.contains(&format!("`{bad}`")), "{e}");
+    }
+    // the command line names the flag and the value, exit code 2
+    let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
+        .args(["simulate", arg, "--time-tol", "0", "--quiet"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--time-tol") && err.contains("`0`"), "{err}");
 }
 
 #[test]
@@ -355,7 +397,10 @@ fn ignored_and_unknown_keys_warn_once_each() {
         .iter()
         .find(|w| w.contains("frame_steps"))
         .unwrap();
-    assert!(steps.contains("one implicit step per frame"), "{steps}");
+    assert!(
+        steps.contains("chosen by their estimated error (solver.time_tol 1e-4 m"),
+        "{steps}"
+    );
     // the honoured keys still apply
     assert_eq!(c.scene.damping, 1e-3);
     assert_eq!(c.scene.handle_stiffness, Some(1e5));

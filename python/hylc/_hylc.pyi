@@ -113,7 +113,7 @@ def simulate(
     duration: Optional[float] = None,
     dt: Optional[float] = None,
     edge: Optional[float] = None,
-    time_tol: Optional[float] = None,
+    time_tol: Optional[Union[float, str]] = None,
 ) -> dict[str, Any]: ...
 def gradient(
     scene: str,

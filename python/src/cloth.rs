@@ -5,7 +5,7 @@ use crate::arrays::to_2d;
 use crate::errors::{detached, HyError};
 use hylc::shell::scene::run_with;
 use hylc::shell::solver::StepReport;
-use hylc::workflow::simulate::{prepare, Overrides};
+use hylc::workflow::simulate::{prepare, Overrides, TimeTol};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -48,13 +48,31 @@ fn log_columns<'py>(py: Python<'py>, log: &[StepReport], d: &Bound<'py, PyDict>)
     Ok(())
 }
 
+/// `time_tol` as Python gives it: a length or the word `off`.
+#[derive(FromPyObject)]
+pub enum TolArg {
+    Metres(f64),
+    Word(String),
+}
+
+impl TolArg {
+    fn parse(self) -> PyResult<TimeTol> {
+        let text = match self {
+            TolArg::Metres(t) => t.to_string(),
+            TolArg::Word(w) => w,
+        };
+        text.parse::<TimeTol>()
+            .map_err(|e| pyo3::exceptions::PyValueError::new_err(format!("time_tol: {e}")))
+    }
+}
+
 /// Run a cloth scene (a scene JSON file, an ARCSim scene file or a built-in: stretch-x, stretch-y, drape-x,
 /// drape-y, hanging) as `hylc simulate` does, with its overrides. With `out`, the frames (`frame_NNNN.obj`) and
 /// `log.jsonl` are written there as well. Returns a dict: the step log as (steps,) arrays (`step`, `time`,
 /// `newton`, `residual`, energies, …; `strain_*` (steps, 6); `handle_forces` name → (steps, 3)), `positions`
 /// (vertices, 3) and `triangles` (triangles, 3) of the final state, and `summary` (steps, Newton iterations,
-/// wall time). `time_tol` (m) chooses substeps by their estimated error, as the scene's `solver.time_tol`. A step
-/// that fails even at the smallest substep raises `SimulationError`.
+/// wall time). `time_tol` (m) chooses substeps by their estimated error, as the scene's `solver.time_tol`, and
+/// `"off"` turns that off. A step that fails even at the smallest substep raises `SimulationError`.
 #[pyfunction]
 #[pyo3(signature = (scene, out=None, material=None, duration=None, dt=None, edge=None, time_tol=None))]
 #[allow(clippy::too_many_arguments)]
@@ -66,8 +84,9 @@ pub fn simulate<'py>(
     duration: Option<f64>,
     dt: Option<f64>,
     edge: Option<f64>,
-    time_tol: Option<f64>,
+    time_tol: Option<TolArg>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let time_tol = time_tol.map(TolArg::parse).transpose()?;
     let ov = Overrides {
         material,
         duration,

@@ -96,6 +96,17 @@ def test_simulate_bad_input_raises(tmp_path):
         hylc.simulate("no-such-scene")
     with pytest.raises(ValueError, match="--dt"):
         hylc.simulate("stretch-x", dt=-1.0)
+    with pytest.raises(ValueError, match="time_tol: expected a positive length"):
+        hylc.simulate("stretch-x", time_tol="sometimes")
+    with pytest.raises(ValueError, match="time_tol"):
+        hylc.simulate("stretch-x", time_tol=0.0)
+
+
+def test_simulate_time_tol_off_is_one_step_per_frame():
+    off = hylc.simulate("stretch-x", duration=0.05, time_tol="off")
+    tight = hylc.simulate("stretch-x", duration=0.05, time_tol=1e-6)
+    assert off["substeps"].max() == 1
+    assert tight["substeps"].sum() > off["substeps"].sum()
 
 
 def test_import_exposes_the_api():

@@ -14,8 +14,8 @@ pub struct Overrides {
     pub material: Option<String>,
     pub duration: Option<f64>,
     pub dt: Option<f64>,
-    /// The largest estimated local error of a substep (m), `solver.time_tol`.
-    pub time_tol: Option<f64>,
+    /// `solver.time_tol`: the largest estimated local error of a substep, or off.
+    pub time_tol: Option<TimeTol>,
     /// The scheme of a substep, `solver.integrator`.
     pub integrator: Option<crate::shell::solver::Integrator>,
     /// Equal substeps per step, `solver.substeps`.
@@ -28,6 +28,30 @@ pub struct Overrides {
     pub in_plane_only: bool,
     /// also a `.vtu` frame (ψ and the strain per triangle) beside each OBJ, `output.vtu`
     pub vtu: bool,
+}
+
+/// How substeps are chosen (`docs/cloth-simulator.md`, "Substeps chosen by accuracy"): by their estimated local
+/// error, at most `Metres(τ)`, or `Off` (they shorten only when Newton fails). Read from `off` or a length.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TimeTol {
+    Off,
+    Metres(f64),
+}
+
+impl std::str::FromStr for TimeTol {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<TimeTol, String> {
+        if s == "off" {
+            return Ok(TimeTol::Off);
+        }
+        match s.parse::<f64>() {
+            Ok(t) if t.is_finite() && t > 0.0 => Ok(TimeTol::Metres(t)),
+            _ => Err(format!(
+                "expected a positive length (m) or `off`, got `{s}`"
+            )),
+        }
+    }
 }
 
 /// The scene `scene_arg` (a JSON file or a built-in) after the overrides, with the folder its relative paths
@@ -70,13 +94,15 @@ pub fn prepare_noted(
         }
         scene.dt = dt;
     }
-    if let Some(tol) = ov.time_tol {
-        if !(tol.is_finite() && tol > 0.0) {
+    match ov.time_tol {
+        Some(TimeTol::Metres(tol)) if !(tol.is_finite() && tol > 0.0) => {
             return Err(WorkflowError::Input(format!(
-                "--time-tol {tol}: expected a positive length (m)"
+                "--time-tol {tol}: expected a positive length (m) or `off`"
             )));
         }
-        scene.solver.time_tol = Some(tol);
+        Some(TimeTol::Metres(tol)) => scene.solver.time_tol = Some(tol),
+        Some(TimeTol::Off) => scene.solver.time_tol = None,
+        None => {}
     }
     if let Some(i) = ov.integrator {
         scene.solver.integrator = i;

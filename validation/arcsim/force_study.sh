@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Where the handle force of the original's tests/2D/conf/stock_stretchX.json differs from the published one
-# (issue 18, Deliver 6: 0.83, 1.70, 2.97, 4.23 N at t = 0.1, 0.2, 0.3, 0.4 s, the original simulator with
+# (0.83, 1.70, 2.97, 4.23 N at t = 0.1, 0.2, 0.3, 0.4 s, the original simulator with
 # remeshing): the scene converted once (`hylc simulate --print`), then run to 0.4 s in variants that each change
 # one thing against `base` (our defaults for an ARCSim scene: one implicit step per frame, 1/60 s, fixed mesh):
 #   dt600   ten times smaller step (1/600 s; the original takes 80 linearised substeps per frame)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The original's 42 cloth scenes (issue 18, Deliver 5): runs every ARCSim-HYLC scene of
+# The original's 42 cloth scenes: runs every ARCSim-HYLC scene of
 # ../shared/data/arcsim-hylc/tests/{1D,2D,small}/conf with `hylc simulate` (read as ARCSim scenes, converted on the
 # fly), then writes validation/arcsim/results.md (one row per scene: wall time per simulated second, Newton
 # iterations per step, substeps, steps not converged, final elastic energy and bounding box, handle forces of the
@@ -12,9 +12,11 @@
 #   DURATION=0.2 validation/arcsim/run_all.sh 2D/stock_stretchX       # some scenes (<set>/<scene> or a regex)
 #   SUMMARY_ONLY=1 validation/arcsim/run_all.sh                       # only rebuild the table and plots
 #   RERUN=1 validation/arcsim/run_all.sh                              # rerun scenes already done (default: resume)
+#   FLAGS="--time-tol off" validation/arcsim/run_all.sh               # extra `hylc simulate` flags (here: one
+#                                                                     # implicit step per frame, as results.md)
 #
 # Environment: HYLC (binary, default target/release/hylc), HYLC_SHARED (default ../shared), OUT (default
-# out/arcsim), DURATION (default 0.5), FULL=1 (the scenes' own end_time), SUMMARY_ONLY=1, RESULTS (the table,
+# out/arcsim), FLAGS (extra flags for every `hylc simulate`, named in the table), DURATION (default 0.5), FULL=1 (the scenes' own end_time), SUMMARY_ONLY=1, RESULTS (the table,
 # default validation/arcsim/results.md), PLOTS (the PNGs' folder, default validation/arcsim).
 set -uo pipefail
 cd "$(dirname "$0")/../.."
@@ -48,6 +50,8 @@ if [ "${SUMMARY_ONLY:-0}" != 1 ]; then
     rm -rf "$dir"; mkdir -p "$dir"
     echo "$tag" > "$dir/duration"
     args=(simulate "$f" --quiet --out "$dir")
+    # shellcheck disable=SC2206 # FLAGS is split into words on purpose
+    args+=(${FLAGS:-})
     if [ "$FULL" != 1 ]; then args+=(--duration "$DURATION"); fi
     if [ "$FULL" = 1 ]; then echo "== $id (full length)"; else echo "== $id (first $DURATION s)"; fi
     start=$(date +%s.%N)

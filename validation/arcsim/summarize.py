@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Tables and plots of the original's 42 cloth scenes (issue 18, Deliver 5), from the runs of run_all.sh.
+"""Tables and plots of the original's 42 cloth scenes, from the runs of run_all.sh.
 
 Reads <out>/<set>/<scene>/{log.jsonl, frame_NNNN.obj, exit_code, wall_seconds, stderr.txt} and writes
 - <results>: one row per scene (simulated time, steps, wall time per simulated second, Newton iterations per step,
@@ -24,7 +24,7 @@ import sys
 SETS = ["1D", "2D", "small"]
 MATERIALS = ["basket", "honey", "rib", "satin", "stock"]
 TIMES = [0.1, 0.2, 0.3, 0.4]
-# the original simulator on tests/2D/conf/stock_stretchX.json (remeshing on), |Fx| in N (issue 18, Deliver 6)
+# the original simulator on tests/2D/conf/stock_stretchX.json (remeshing on), |Fx| in N
 REFERENCE = {"2D/stock_stretchX": [0.83, 1.70, 2.97, 4.23]}
 
 
@@ -257,7 +257,9 @@ def main():
         "# The original's cloth scenes (ARCSim-HYLC) with `hylc simulate`",
         "",
         "Written by `validation/arcsim/run_all.sh` (`summarize.py`): each ARCSim scene read as it is (converted, "
-        "fixed `hylc_square.obj` mesh, no remeshing), one implicit step per frame (1/60 s) with adaptive substeps. "
+        "fixed `hylc_square.obj` mesh, no remeshing), "
+        + (f"with `{os.environ['FLAGS']}`" if os.environ.get("FLAGS") else "with the conversion's settings")
+        + " (frames of 1/60 s; `--time-tol off`: one implicit step per frame, halved when Newton fails). "
         "Wall time per simulated second sums the steps' wall times (setup excluded). Machine: "
         f"{os.cpu_count()} cores.",
         "",

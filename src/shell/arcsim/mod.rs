@@ -7,8 +7,9 @@
 //! - `hylc.material` → `material`, `hylc.only1D` → `model.only_1d`; `psd` is `psi` as in our built-ins;
 //! - `cloths[0].mesh` + `transform` → `mesh: {"obj": ..}` (rest layout = scaled OBJ x, y; initial state = the
 //!   transformed OBJ); `cloths[0].materials[0].damping` → `damping`;
-//! - `frame_time` → `dt` (one implicit step per frame, our adaptive substeps take over where the original took
-//!   `frame_steps` substeps), one OBJ per frame; `end_time` → `duration`;
+//! - `frame_time` → `dt`, one OBJ per frame; implicit Euler substeps chosen by their estimated error
+//!   (`solver.time_tol` = [`DEFAULT_TIME_TOL`], where the original took `frame_steps` substeps); `end_time` →
+//!   `duration`;
 //! - `motions` → translation keyframes interpolated as ARCSim does (cubic Hermite with its velocities,
 //!   `velocity` keys honoured; [`crate::shell::motion`]);
 //! - `handlebars` → `handles` with a box selection in the rest layout ([`Handlebar`]) following
@@ -31,7 +32,7 @@ pub mod json;
 mod read;
 
 pub use convert::{
-    DEFAULT_HANDLE_STIFFNESS, DEFAULT_OBS_FRICTION, DEFAULT_REPULSION_THICKNESS,
+    DEFAULT_HANDLE_STIFFNESS, DEFAULT_OBS_FRICTION, DEFAULT_REPULSION_THICKNESS, DEFAULT_TIME_TOL,
     DEFAULT_WIND_DENSITY,
 };
 pub use handlebar::{bounds, Handlebar, GROW, SIDES};
