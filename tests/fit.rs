@@ -200,8 +200,8 @@ fn compression_residual_predicts_a_coupled_truth_and_only_adds_energy() {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         (Material::load(&out).unwrap(), report(&rep))
     };
-    let (base, rb) = fit("base", &[]);
-    let (ext, re) = fit("ext", &["--compression-residual"]);
+    let (base, rb) = fit("base", &["--preset", "design"]);
+    let (ext, re) = fit("ext", &["--preset", "design", "--compression-residual"]);
     // the model on the planes with shear, which reach far into compression (the held-out grid only to −0.2)
     for t in 0..3 {
         let m = |r: &serde_json::Value| r["terms2d"][t]["model"]["rms_rel"].as_f64().unwrap();
@@ -223,9 +223,10 @@ fn compression_residual_predicts_a_coupled_truth_and_only_adds_energy() {
         ext.extra["meta"]["fit options"]["compression_residual"],
         serde_json::json!(true)
     );
-    assert!(base.extra["meta"]["fit options"]
-        .get("compression_residual")
-        .is_none());
+    assert_eq!(
+        base.extra["meta"]["fit options"]["compression_residual"],
+        serde_json::json!(false)
+    );
     use rand::{Rng, SeedableRng};
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(19);
     let (mut below_base, mut below_ext) = (0, 0);
@@ -320,10 +321,14 @@ fn covering_knots_fit_the_corner_of_a_coarse_plan_better() {
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         report(&rep)
     };
-    let design = fit("design", &[]);
-    let covering = fit(
-        "covering",
+    let design = fit("design", &["--preset", "design"]);
+    // the default preset is `covering`: the same fit as its settings one by one on top of `design`
+    let covering = fit("covering", &[]);
+    let by_flags = fit(
+        "by-flags",
         &[
+            "--preset",
+            "design",
             "--compression-residual",
             "--knots-2d",
             "11",
@@ -339,6 +344,15 @@ fn covering_knots_fit_the_corner_of_a_coarse_plan_better() {
             "1",
         ],
     );
+    let coefficients = |name: &str| {
+        let m = Material::load(&d.join(format!("{name}.material.json"))).unwrap();
+        m.coefficients()
+            .into_iter()
+            .map(|c| m.coefficient(c))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(coefficients("covering"), coefficients("by-flags"));
+    assert_eq!(covering["all"], by_flags["all"]);
     let term = |r: &serde_json::Value| {
         let t = r["terms2d"]
             .as_array()

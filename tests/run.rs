@@ -237,3 +237,100 @@ fn run_checks_its_inputs_before_computing() {
         assert!(!out.exists(), "{flag} {value}: wrote {}", out.display());
     }
 }
+
+/// The README's hand-run recipe (generate → reference → sample with the crossing guard → fit with the default
+/// preset) makes the very material `hylc run` makes: the same bytes, when both name their files alike (run in
+/// two folders with the same relative paths; `hylc run`'s held-out grid is copied beside the recipe's samples,
+/// as `--holdout`).
+#[test]
+fn the_hand_run_recipe_makes_run_s_material_byte_for_byte() {
+    let dir = std::env::temp_dir().join(format!("hylc-run-recipe-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let (a, b) = (dir.join("run"), dir.join("hand"));
+    std::fs::create_dir_all(&a).unwrap();
+    std::fs::create_dir_all(b.join("out/plain")).unwrap();
+    let mut p = Plan::reduced();
+    p.count_1d = 5;
+    p.count_2d = 3;
+    let plan = dir.join("tiny.json");
+    std::fs::write(&plan, serde_json::to_string(&p).unwrap()).unwrap();
+    let plan = plan.to_str().unwrap();
+    let hylc_in = |cwd: &PathBuf, args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_hylc"))
+            .current_dir(cwd)
+            .args(args)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stderr).to_string();
+        // `sample` exits with 3 when a sample did not converge; the fit leaves it out, as `run` does
+        let ok = out.status.success() || (args[0] == "sample" && out.status.code() == Some(3));
+        assert!(ok, "hylc {args:?}: {:?} {text}", out.status.code());
+    };
+    hylc_in(
+        &a,
+        &[
+            "run",
+            "--pattern",
+            "plain",
+            "--plan",
+            plan,
+            "--edge",
+            "0.05",
+            "--duration",
+            "0.0125",
+            "--dt",
+            "0.0125",
+            "--out",
+            "out",
+        ],
+    );
+    for f in ["holdout.jsonl", "holdout.meta.json"] {
+        std::fs::copy(a.join("out/plain").join(f), b.join("out/plain").join(f)).unwrap();
+    }
+    for args in [
+        &["generate", "plain", "--out", "out/plain/pattern.pyp"][..],
+        &[
+            "reference",
+            "out/plain/pattern.pyp",
+            "--construction",
+            "woven",
+            "--out",
+            "out/plain/reference.pyp",
+        ],
+        &[
+            "sample",
+            "out/plain/reference.pyp",
+            "--plan",
+            plan,
+            "--out",
+            "out/plain/samples.jsonl",
+            "--crossings",
+            "reject",
+        ],
+        &[
+            "fit",
+            "out/plain/samples.jsonl",
+            "--out",
+            "out/plain/material.json",
+            "--holdout",
+            "out/plain/holdout.jsonl",
+            "--no-plots",
+        ],
+    ] {
+        hylc_in(&b, args);
+    }
+    let read = |root: &PathBuf| std::fs::read(root.join("out/plain/material.json")).unwrap();
+    let (made_by_run, made_by_hand) = (read(&a), read(&b));
+    assert!(
+        made_by_run == made_by_hand,
+        "the materials differ:\n{}\n---\n{}",
+        String::from_utf8_lossy(&made_by_run),
+        String::from_utf8_lossy(&made_by_hand)
+    );
+    // the material records how it was fitted: the default preset's options
+    let m: serde_json::Value = serde_json::from_slice(&made_by_run).unwrap();
+    let fit: hylc::fit::FitOptions =
+        serde_json::from_value(m["meta"]["fit options"].clone()).unwrap();
+    assert_eq!(fit, hylc::fit::FitPreset::Covering.options());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -26,8 +26,8 @@ PATTERNS=("$@")
 [ ${#PATTERNS[@]} -eq 0 ] && PATTERNS=(basket satin slip_stitch_honeycomb stockinette cartridge_belt_rib)
 for pat in "${PATTERNS[@]}"; do
   mat=${MAT[$pat]:?unknown pattern $pat}
-  flags=""
-  [ "$pat" = stockinette ] && flags=--stockinette-like
+  flags="--preset design"  # the method's settings, as the original materials were fitted
+  [ "$pat" = stockinette ] && flags="--preset design-stockinette"
   echo "== $pat"
   /usr/bin/time -f "sample wall time %e s" "$HYLC" sample "$D/patterns/$pat.pyp" --plan "validation/plans/$pat$PLAN.json" \
     --out "$OUT/$pat$PLAN.jsonl"

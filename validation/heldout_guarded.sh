@@ -33,9 +33,9 @@ for pat in "${PATTERNS[@]}"; do
   wide=$OUT/${pat}_wide.jsonl
   /usr/bin/time -f "wide plan: %e s wall, %U s user" "$HYLC" sample "$D/patterns/$pat.pyp" \
     --plan "validation/plans/${pat}_wide.json" --out "$wide" "${guard[@]}" | tail -n 1
-  "$HYLC" fit "$wide" --out "$OUT/${pat}_wide.material.json" --report "$OUT/${pat}_wide.fit.json" --no-plots \
+  "$HYLC" fit "$wide" --preset design --out "$OUT/${pat}_wide.material.json" --report "$OUT/${pat}_wide.fit.json" --no-plots \
     | grep -E "all fitted|held-out"
-  "$HYLC" fit "$wide" --compression-residual --asymmetric-shear --out "$OUT/${pat}_wide_ext.material.json" \
+  "$HYLC" fit "$wide" --preset design --compression-residual --asymmetric-shear --out "$OUT/${pat}_wide_ext.material.json" \
     --report "$OUT/${pat}_wide_ext.fit.json" --no-plots | grep -E "all fitted|held-out"
   held=$OUT/${pat}_holdout.jsonl
   /usr/bin/time -f "held-out grid: %e s wall, %U s user" "$HYLC" sample "$D/patterns/$pat.pyp" \

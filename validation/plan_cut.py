@@ -71,7 +71,7 @@ def errors(records, psi, idx):
 def fit_and_evaluate(args, stem, source_meta, records, zfile):
     """Fit `stem`.jsonl (its sidecar copied from `source_meta`), evaluate at every record: ψ per record."""
     shutil.copy(source_meta, stem + ".meta.json")
-    subprocess.run([args.hylc, "fit", stem + ".jsonl", "--no-plots"], check=True, capture_output=True)
+    subprocess.run([args.hylc, "fit", stem + ".jsonl", "--no-plots", "--preset", "design"], check=True, capture_output=True)
     out = subprocess.run([args.hylc, "material", stem + ".material.json", "--z-file", zfile, "--json"],
                          check=True, capture_output=True, text=True).stdout
     psi = [json.loads(line)["psi"] for line in out.splitlines() if line.strip()]

@@ -140,7 +140,7 @@ for plan in ["quick", "reduced"]:
     f = os.path.join(WORK, f"{plan}.jsonl")
     _, t = sh(["sample", ref, "--out", f, "--plan", plan])
     n = sum(1 for _ in open(f))
-    out, _ = sh(["fit", f, "--no-plots", "--holdout", hold])
+    out, _ = sh(["fit", f, "--no-plots", "--preset", "design", "--holdout", hold])
     rep = json.load(open(f.replace(".jsonl", ".fit.json")))
     h = rep["holdout"]
     st = sum(json.loads(l)["time"] for l in open(f))
@@ -173,7 +173,7 @@ for name, f, h in sets:
             os.remove(tmeta)
         os.symlink(meta, tmeta)
         t0 = time.time()
-        sh(["fit", tmp, "--no-plots", "--holdout", h, "--knots-1d", k1, "--knots-2d", k2])
+        sh(["fit", tmp, "--no-plots", "--preset", "design", "--holdout", h, "--knots-1d", k1, "--knots-2d", k2])
         t = time.time() - t0
         rep = json.load(open(tmp.replace(".jsonl", ".fit.json")))
         r1 = max(t["fit_rms_rel"] for t in rep["terms1d"])

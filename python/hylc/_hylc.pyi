@@ -102,9 +102,9 @@ def fit(
     plots: Optional[StrPath] = None,
     plan: Optional[str] = None,
     density: Optional[float] = None,
-    stockinette_like: bool = False,
-    knots_1d: int = 11,
-    knots_2d: int = 9,
+    preset: str = "covering",
+    knots_1d: Optional[int] = None,
+    knots_2d: Optional[int] = None,
 ) -> tuple[Material, dict[str, Any]]: ...
 def simulate(
     scene: str,

@@ -4,7 +4,7 @@
 use crate::arrays::{rows, shaped, Array, Rows};
 use crate::convert::report as report_to_py;
 use crate::errors::{detached, HyError, HyResult, Kind};
-use hylc::fit::model::FitOptions;
+use hylc::fit::FitPreset;
 use hylc::material::synthetic::default_material;
 use hylc::material::{Material, PsiVgh};
 use hylc::workflow::fit::{fit_samples, FitJob};
@@ -162,11 +162,13 @@ impl PyMaterial {
     }
 }
 
-/// Fit a material to a sample file (Algorithm C5, as `hylc fit SAMPLES` with its defaults): writes the material
-/// JSON (`out`, default SAMPLES with extension .material.json) and the JSON fit report (`report`, default
-/// .fit.json), PNG plots only when `plots` (a folder) is given. Returns (Material, report dict).
+/// Fit a material to a sample file (Algorithm C5, as `hylc fit SAMPLES`): writes the material JSON (`out`,
+/// default SAMPLES with extension .material.json) and the JSON fit report (`report`, default .fit.json), PNG
+/// plots only when `plots` (a folder) is given. `preset` is the fit's settings as `hylc fit --preset` takes them
+/// (`covering`, the default and `hylc run`'s; `design`; `design-stockinette`); `knots_1d` and `knots_2d` change
+/// the preset's knot counts. Returns (Material, report dict).
 #[pyfunction]
-#[pyo3(signature = (samples, out=None, report=None, plots=None, plan=None, density=None, stockinette_like=false, knots_1d=11, knots_2d=9))]
+#[pyo3(signature = (samples, out=None, report=None, plots=None, plan=None, density=None, preset="covering", knots_1d=None, knots_2d=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn fit<'py>(
     py: Python<'py>,
@@ -176,10 +178,13 @@ pub fn fit<'py>(
     plots: Option<PathBuf>,
     plan: Option<String>,
     density: Option<f64>,
-    stockinette_like: bool,
-    knots_1d: usize,
-    knots_2d: usize,
+    preset: &str,
+    knots_1d: Option<usize>,
+    knots_2d: Option<usize>,
 ) -> PyResult<(PyMaterial, Bound<'py, PyAny>)> {
+    let preset: FitPreset = preset
+        .parse()
+        .map_err(|e: String| HyError::new(Kind::Value, format!("preset: {e}")))?;
     if !samples.exists() {
         return Err(HyError::new(
             Kind::NotFound,
@@ -188,13 +193,9 @@ pub fn fit<'py>(
         .into());
     }
     let beside = FitJob::beside(&samples);
-    let mut options = if stockinette_like {
-        FitOptions::stockinette_like()
-    } else {
-        FitOptions::default()
-    };
-    options.n_knots_1d = knots_1d;
-    options.n_knots_2d = knots_2d;
+    let mut options = preset.options();
+    options.n_knots_1d = knots_1d.unwrap_or(options.n_knots_1d);
+    options.n_knots_2d = knots_2d.unwrap_or(options.n_knots_2d);
     let job = FitJob {
         out: out.unwrap_or(beside.out),
         report: report.unwrap_or(beside.report),

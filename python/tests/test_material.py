@@ -109,3 +109,14 @@ def test_fit_equals_the_cli(quick_samples, tmp_path, cli):
     np.testing.assert_array_equal(material.psi(z), hylc.Material.load(tmp_path / "cli.material.json").psi(z))
     with pytest.raises(FileNotFoundError, match="samples: missing.jsonl"):
         hylc.fit("missing.jsonl")
+
+
+def test_fit_presets_equal_the_cli_and_bad_names_raise(quick_samples, tmp_path, cli):
+    hylc.fit(quick_samples, out=tmp_path / "py.material.json", report=tmp_path / "py.fit.json", preset="design")
+    cli("fit", quick_samples, "--preset", "design", "--out", tmp_path / "cli.material.json", "--report",
+        tmp_path / "cli.fit.json", "--no-plots")
+    assert (tmp_path / "py.material.json").read_text() == (tmp_path / "cli.material.json").read_text()
+    meta = json.loads((tmp_path / "py.material.json").read_text())["meta"]
+    assert meta["fit options"]["bandwidth_factor"] == 2.0 and meta["fit options"]["compression_residual"] is False
+    with pytest.raises(ValueError, match="unknown fit preset `fast`"):
+        hylc.fit(quick_samples, preset="fast")

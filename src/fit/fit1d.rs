@@ -37,7 +37,8 @@ pub enum MinimumAt {
 }
 
 /// Where the knot slopes pˣ come from (step 2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum SlopeSource {
     /// central differences of g (the original's choice)
     FiniteDifference,

@@ -8,6 +8,7 @@ pub mod fit2d;
 pub mod mls;
 pub mod model;
 pub mod plot;
+pub mod preset;
 pub mod symlog;
 
 pub use fit1d::{
@@ -20,6 +21,7 @@ pub use model::{
     MAX_SAMPLE_VALUE,
 };
 pub use plot::PlotError;
+pub use preset::FitPreset;
 
 /// Why a fit could not be made. Bad input is reported, never a panic.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

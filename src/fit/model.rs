@@ -26,8 +26,10 @@ use crate::sample::{Plan, Record, Sample};
 use crate::strain::StrainComponent;
 use serde::Serialize;
 
-/// Options of the whole fit; [`Default`] gives the design's defaults.
-#[derive(Clone, Debug, PartialEq)]
+/// Options of the whole fit; [`Default`] gives the design's defaults. A fitted material records them in its
+/// `meta["fit options"]` (the same keys), so that it can be refitted as it was made.
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FitOptions {
     /// N_c of FIT1D (default 11)
     pub n_knots_1d: usize,
@@ -90,7 +92,7 @@ impl FitOptions {
     /// axis, so no sample lies beyond the knot box, where step 8 holds the residual constant, and no 1D sample
     /// on the linear continuation), the compressed half-plane keeps its residual (FIT2D step 7′), and the MLS
     /// bandwidth is one median spacing instead of two (a 6 × 6 grid's spacing is a third of the range: two
-    /// spacings smooth away the biaxial stiffening). Measurements in the README ("Set-up").
+    /// spacings smooth away the biaxial stiffening); the `covering` preset ([`super::FitPreset`]).
     pub fn covering() -> Self {
         FitOptions {
             extent_1d: 1.0,
@@ -648,28 +650,11 @@ fn meta_block(
     report: &FitReport,
 ) -> serde_json::Map<String, serde_json::Value> {
     meta.insert("plan".into(), serde_json::json!(report.plan_hash));
+    // every option, by the names of `FitOptions`, so that the material can be refitted as it was made
     meta.insert(
         "fit options".into(),
-        serde_json::json!({
-            "n_knots_1d": opts.n_knots_1d, "n_knots_2d": opts.n_knots_2d, "extent_2d": opts.extent_2d,
-            "n_knots_2d_bending": opts.n_knots_2d_bending, "extent_2d_bending": opts.extent_2d_bending,
-            "min_slope": opts.min_slope, "bandwidth_factor": opts.bandwidth_factor, "eps_rel": opts.eps_rel,
-            "slopes": format!("{:?}", opts.slopes), "thin_1d": opts.thin_1d,
-            "strict_patches": opts.strict_patches,
-        }),
+        serde_json::to_value(opts).expect("fit options serialise"),
     );
-    // the optional fit settings appear only when set, so a default fit's meta block stays as it was
-    if let Some(serde_json::Value::Object(o)) = meta.get_mut("fit options") {
-        if opts.compression_residual {
-            o.insert("compression_residual".into(), serde_json::json!(true));
-        }
-        if !opts.symmetric_shear {
-            o.insert("symmetric_shear".into(), serde_json::json!(false));
-        }
-        if opts.extent_1d != FitOptions::default().extent_1d {
-            o.insert("extent_1d".into(), serde_json::json!(opts.extent_1d));
-        }
-    }
     meta.insert(
         "fit errors".into(),
         serde_json::json!({

@@ -8,6 +8,7 @@ use crate::fit::model::{
     check_records, compare_1d, fit_material, model_error, FitOptions, FitReport,
 };
 use crate::fit::plot::plot_material_fit;
+use crate::fit::FitPreset;
 use crate::material::Material;
 use crate::sample::{read_samples, Plan, Record};
 use std::path::{Path, PathBuf};
@@ -37,7 +38,8 @@ pub struct FitJob {
 }
 
 impl FitJob {
-    /// A job with the default file names beside `samples` (`.material.json`, `.fit.json`, `.plots`).
+    /// A job with the default file names beside `samples` (`.material.json`, `.fit.json`, `.plots`) and the
+    /// default preset's options ([`FitPreset::Covering`]).
     pub fn beside(samples: &Path) -> Self {
         FitJob {
             samples: samples.to_path_buf(),
@@ -48,9 +50,20 @@ impl FitJob {
             density: None,
             holdout: Vec::new(),
             compare: None,
-            options: FitOptions::default(),
+            options: FitPreset::default().options(),
             write_plots: true,
         }
+    }
+}
+
+/// How the material file `out` names the file `f`: by its name alone when both are in the same folder (so that
+/// the material reads the same wherever the folder is), else as given.
+fn beside_name(f: &Path, out: &Path) -> String {
+    let dir =
+        |p: &Path| std::fs::canonicalize(p.parent().filter(|d| !d.as_os_str().is_empty())?).ok();
+    match (dir(f), dir(out), f.file_name()) {
+        (Some(a), Some(b), Some(name)) if a == b => name.to_string_lossy().into_owned(),
+        _ => f.display().to_string(),
     }
 }
 
@@ -137,7 +150,7 @@ pub fn fit_samples(
     let mut material_meta = serde_json::Map::new();
     material_meta.insert(
         "samples".into(),
-        serde_json::json!(samples.display().to_string()),
+        serde_json::json!(beside_name(samples, &job.out)),
     );
     if let Some(m) = &meta {
         for key in ["pattern", "pyp hash", "problem", "yarn", "solver"] {
@@ -178,7 +191,7 @@ pub fn fit_samples(
         if let Some(serde_json::Value::Object(m)) = fit.material.extra.get_mut("meta") {
             m.insert(
                 "holdout".into(),
-                serde_json::json!({"file": h.display().to_string(), "samples": e.n_samples,
+                serde_json::json!({"file": beside_name(h, &job.out), "samples": e.n_samples,
                     "rms_rel": e.rms_rel, "max_rel": e.max_rel}),
             );
         }

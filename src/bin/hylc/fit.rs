@@ -4,7 +4,7 @@
 use crate::printer::Printer;
 use clap::ValueEnum;
 use hylc::fit::model::FitOptions;
-use hylc::fit::SlopeSource;
+use hylc::fit::{FitPreset, SlopeSource};
 use hylc::workflow::fit::{fit_samples, FitJob};
 use hylc::workflow::WorkflowError;
 use std::path::PathBuf;
@@ -39,52 +39,76 @@ pub struct Args {
     /// compare the fitted 1D curves f₀ + f_k with another material file (e.g. the original's)
     #[arg(long)]
     compare: Option<PathBuf>,
-    /// the stockinette settings of the design: pˣ_min = 0.01, 2D knots on 0.3 of the range
+    /// the fit's settings (docs/fitting.md, "Presets"): covering (knots over the whole sampled range, for
+    /// plans with few samples per axis such as the quick plan; `hylc run`'s), design (the method's own, for
+    /// dense plans) or design-stockinette (design with the original stockinette material's layout); the flags
+    /// below change single settings of it
+    #[arg(long, value_enum, default_value = "covering")]
+    preset: PresetArg,
+    /// knots of each 1D term, N_c [preset: 11]
     #[arg(long)]
-    stockinette_like: bool,
-    /// knots of each 1D term (N_c)
-    #[arg(long, default_value_t = 11)]
-    knots_1d: usize,
-    /// knots per axis of each 2D term
-    #[arg(long, default_value_t = 9)]
-    knots_2d: usize,
-    /// minimum slope pˣ_min (default 0.001, or 0.01 with --stockinette-like)
+    knots_1d: Option<usize>,
+    /// knots per axis of each in-plane 2D term [covering: 11, design: 9]
+    #[arg(long)]
+    knots_2d: Option<usize>,
+    /// minimum slope pˣ_min [0.001; design-stockinette: 0.01]
     #[arg(long)]
     min_slope: Option<f64>,
-    /// extent of the 2D knots as a fraction of the data range (default 0.9, or 0.3 with --stockinette-like)
+    /// extent of the in-plane 2D knots as a fraction of the data range [covering: 1, design: 0.9]
     #[arg(long)]
     extent: Option<f64>,
     /// slopes of the 1D terms: fd (finite differences of the MLS) or stress (MLS of the sampled stresses)
-    #[arg(long, value_enum, default_value = "fd")]
-    slopes: SlopesArg,
-    /// fit the 1D terms to every K-th sample of their ranges only (the others are held out)
-    #[arg(long, default_value_t = 1, value_name = "K")]
-    thin_1d: usize,
+    /// [preset: fd]
+    #[arg(long, value_enum)]
+    slopes: Option<SlopesArg>,
+    /// fit the 1D terms to every K-th sample of their ranges only (the others are held out) [1]
+    #[arg(long, value_name = "K")]
+    thin_1d: Option<usize>,
     /// stop FIT2D's monotone correction after the twists (report non-monotone patches instead of shrinking
     /// the cross slopes)
     #[arg(long)]
     twist_only: bool,
     /// keep FIT2D's residual on the compressed half-plane of s_x or s_y as a non-negative excess, monotone
-    /// outward from the axes (FIT2D step 7′), instead of zeroing it
-    #[arg(long)]
-    compression_residual: bool,
+    /// outward from the axes (FIT2D step 7′), instead of zeroing it (`--compression-residual false` zeroes it)
+    /// [covering: on, design: off]
+    #[arg(long, value_name = "BOOL", num_args = 0..=1, default_missing_value = "true")]
+    compression_residual: Option<bool>,
     /// fit the two signs of shear s_a separately instead of symmetrising every term in s_a (for patterns whose
     /// Ψ̄ is not even in s_a, e.g. the knits)
     #[arg(long)]
     asymmetric_shear: bool,
-    /// knots per axis of the 2D terms with a bending strain (default 9, or 5 with --stockinette-like)
+    /// knots per axis of the 2D terms with a bending strain [covering: 11, design: 9, design-stockinette: 5]
     #[arg(long)]
     knots_2d_bending: Option<usize>,
-    /// extent of the knots of the 2D terms with a bending strain as a fraction of the data range (default 0.9,
-    /// or 0.3 with --stockinette-like)
+    /// extent of the knots of the 2D terms with a bending strain as a fraction of the data range [covering: 1,
+    /// design: 0.9, design-stockinette: 0.3]
     #[arg(long)]
     extent_bending: Option<f64>,
-    /// MLS bandwidth of every term (1D and 2D) in median sample spacings
-    #[arg(long, default_value_t = 2.0)]
-    bandwidth: f64,
+    /// MLS bandwidth of every term (1D and 2D) in median sample spacings [covering: 1, design: 2]
+    #[arg(long)]
+    bandwidth: Option<f64>,
     /// extent of the knots of the 1D terms as a fraction of each range (beyond them a term continues linearly)
-    #[arg(long, default_value_t = 0.95)]
-    extent_1d: f64,
+    /// [covering: 1, design: 0.95]
+    #[arg(long)]
+    extent_1d: Option<f64>,
+}
+
+/// The fit presets (`hylc::fit::FitPreset`).
+#[derive(ValueEnum, Clone, Copy, Debug)]
+enum PresetArg {
+    Covering,
+    Design,
+    DesignStockinette,
+}
+
+impl From<PresetArg> for FitPreset {
+    fn from(p: PresetArg) -> Self {
+        match p {
+            PresetArg::Covering => FitPreset::Covering,
+            PresetArg::Design => FitPreset::Design,
+            PresetArg::DesignStockinette => FitPreset::DesignStockinette,
+        }
+    }
 }
 
 /// Where the 1D knot slopes come from (`hylc::fit::SlopeSource`).
@@ -104,35 +128,29 @@ impl From<SlopesArg> for SlopeSource {
 }
 
 impl Args {
-    /// The fit options these flags select.
+    /// The fit options these flags select: the preset's, with each flag given replacing one setting.
     fn options(&self) -> FitOptions {
-        let mut options = if self.stockinette_like {
-            FitOptions::stockinette_like()
-        } else {
-            FitOptions::default()
-        };
-        options.n_knots_1d = self.knots_1d;
-        options.n_knots_2d = self.knots_2d;
-        if let Some(m) = self.min_slope {
-            options.min_slope = m;
+        let mut o = FitPreset::from(self.preset).options();
+        let set = |slot: &mut usize, v: Option<usize>| *slot = v.unwrap_or(*slot);
+        set(&mut o.n_knots_1d, self.knots_1d);
+        set(&mut o.n_knots_2d, self.knots_2d);
+        set(&mut o.n_knots_2d_bending, self.knots_2d_bending);
+        set(&mut o.thin_1d, self.thin_1d.map(|k| k.max(1)));
+        let setf = |slot: &mut f64, v: Option<f64>| *slot = v.unwrap_or(*slot);
+        setf(&mut o.min_slope, self.min_slope);
+        setf(&mut o.extent_2d, self.extent);
+        setf(&mut o.extent_2d_bending, self.extent_bending);
+        setf(&mut o.bandwidth_factor, self.bandwidth);
+        setf(&mut o.extent_1d, self.extent_1d);
+        if let Some(s) = self.slopes {
+            o.slopes = s.into();
         }
-        if let Some(e) = self.extent {
-            options.extent_2d = e;
+        if let Some(c) = self.compression_residual {
+            o.compression_residual = c;
         }
-        options.slopes = self.slopes.into();
-        options.thin_1d = self.thin_1d.max(1);
-        options.strict_patches = !self.twist_only;
-        options.compression_residual = self.compression_residual;
-        options.symmetric_shear = !self.asymmetric_shear;
-        if let Some(k) = self.knots_2d_bending {
-            options.n_knots_2d_bending = k;
-        }
-        if let Some(e) = self.extent_bending {
-            options.extent_2d_bending = e;
-        }
-        options.bandwidth_factor = self.bandwidth;
-        options.extent_1d = self.extent_1d;
-        options
+        o.strict_patches &= !self.twist_only;
+        o.symmetric_shear &= !self.asymmetric_shear;
+        o
     }
 }
 
