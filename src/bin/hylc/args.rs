@@ -22,13 +22,13 @@ pub struct SolverArgs {
     /// yarn crossings along the Newton path and, in a sample chain, on the way to each warm or predicted start:
     /// not checked (off), counted (count), or line-search trials and starts that pass two yarn centre lines
     /// through each other rejected (reject); default off (`sample --starts warm+cold|all`: reject). A measured
-    /// trade (README, "The crossing guard"): reject keeps every sample in its fabric, at 0.34–1.2× the speed
+    /// trade (docs/sampling.md, "The crossing guard"): reject keeps every sample in its fabric, at 0.34–1.2× the speed
     #[arg(long, value_enum)]
     pub crossings: Option<CrossingGuardArg>,
-    /// the design's shift rule alone (μ grown until H + μI is positive definite) instead of the default
+    /// the plain shift rule alone (μ grown until H + μI is positive definite) instead of the default
     /// inertia-controlled steps (the exact constrained Newton step wherever H is positive definite on the
-    /// constraint space and the energy follows its quadratic model); reproduces the solver before 5 December
-    /// 2026 bit for bit, and sample files made before then resume only with it
+    /// constraint space and the energy follows its quadratic model); reproduces the solver of sample files made
+    /// before the inertia control bit for bit, and such files resume only with it
     #[arg(long)]
     pub no_inertia: bool,
 }
@@ -77,7 +77,7 @@ impl From<CrossingGuardArg> for CrossingGuard {
 /// `--predictor` of `solve` and `sample` (`hylc::micro::Predictor`).
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PredictorArg {
-    /// Linear extrapolation from the two previous equilibria ([`MicroProblem::predict`]).
+    /// Linear extrapolation from the two previous equilibria.
     Secant,
     /// The previous equilibrium itself (moved to the new strain at fixed unknowns).
     None,
@@ -170,4 +170,22 @@ pub fn parse_list<T: std::str::FromStr>(text: &str, what: &str) -> anyhow::Resul
                 .map_err(|_| anyhow::anyhow!("--{what}: cannot parse {s:?} in {text:?}"))
         })
         .collect()
+}
+
+/// The fit presets (`hylc::fit::FitPreset`).
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum PresetArg {
+    Covering,
+    Design,
+    DesignStockinette,
+}
+
+impl From<PresetArg> for hylc::fit::FitPreset {
+    fn from(p: PresetArg) -> Self {
+        match p {
+            PresetArg::Covering => hylc::fit::FitPreset::Covering,
+            PresetArg::Design => hylc::fit::FitPreset::Design,
+            PresetArg::DesignStockinette => hylc::fit::FitPreset::DesignStockinette,
+        }
+    }
 }

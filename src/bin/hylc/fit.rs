@@ -1,6 +1,7 @@
 //! `hylc fit SAMPLES`: a material from a sample file (Algorithm C5; `docs/sampling.md`, "Fitting (C5, C6,
 //! C7)"; `hylc::workflow::fit`), with the JSON fit report and PNG plots.
 
+use crate::args::PresetArg;
 use crate::printer::Printer;
 use clap::ValueEnum;
 use hylc::fit::model::FitOptions;
@@ -91,24 +92,6 @@ pub struct Args {
     /// [covering: 1, design: 0.95]
     #[arg(long)]
     extent_1d: Option<f64>,
-}
-
-/// The fit presets (`hylc::fit::FitPreset`).
-#[derive(ValueEnum, Clone, Copy, Debug)]
-enum PresetArg {
-    Covering,
-    Design,
-    DesignStockinette,
-}
-
-impl From<PresetArg> for FitPreset {
-    fn from(p: PresetArg) -> Self {
-        match p {
-            PresetArg::Covering => FitPreset::Covering,
-            PresetArg::Design => FitPreset::Design,
-            PresetArg::DesignStockinette => FitPreset::DesignStockinette,
-        }
-    }
 }
 
 /// Where the 1D knot slopes come from (`hylc::fit::SlopeSource`).

@@ -39,8 +39,50 @@ const VERSION: &str = concat!(
 );
 use std::process::ExitCode;
 
+/// The top-level help: the subcommands by group, one line each (`hylc help COMMAND` for the whole text; a test
+/// checks that every subcommand is listed once).
+const GROUPED_HELP: &str = "\
+{before-help}{about-with-newline}
+{usage-heading} {usage}
+
+Pipeline (yarn pattern -> material):
+  run                The whole pipeline on a pattern: reference, samples, fit, a drape
+  generate           Generate a yarn pattern (stockinette, plain, ...)
+  pattern            Load, check and summarise a .pyp pattern
+  reference          The pattern's stress-free reference state (C1)
+  plan               Write a sampling plan as JSON
+  sample             Run a sampling plan (resumable, shardable)
+  merge              Merge sample files (e.g. shards)
+  fit                Fit a material to a sample file (--preset covering|design)
+  material           Evaluate a material's psi and its derivatives at strains
+  yarn               The yarn parameters as JSON
+
+Cloth:
+  simulate           Simulate a cloth scene (ours, an ARCSim-HYLC file or a built-in)
+  gradient           Sensitivities of a scene's observable (adjoint)
+  scene-plan         A sampling plan covering the strains a run visited
+
+Micro-scale analysis:
+  solve              Solve the micro problem at given strains
+  sensitivity        Psi-bar with its derivatives to strain and yarn parameters
+  compare-samples    Samples that differ between two sample files
+  identify           Identify yarn parameters from the original's data
+  calibrate          Yarn parameters that make the original patterns equilibria
+
+Verification and validation:
+  check-derivatives  The derivative harness (AD and finite differences)
+  validate           Validation against the original's data
+  micro-grid         The micro solver against the original displacements
+  fuzz               Mutated inputs through every parser and evaluator
+
+Options:
+{options}
+
+'hylc help COMMAND' or 'hylc COMMAND --help' explains a command.
+";
+
 #[derive(Parser)]
-#[command(name = "hylc", version = VERSION, about = "Homogenized yarn-level cloth")]
+#[command(name = "hylc", version = VERSION, about = "Homogenized yarn-level cloth", help_template = GROUPED_HELP)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -143,5 +185,29 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::from(2)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    /// The grouped top-level help lists every subcommand exactly once, and nothing else.
+    #[test]
+    fn grouped_help_lists_every_subcommand_once() {
+        let listed: Vec<&str> = GROUPED_HELP
+            .lines()
+            .filter(|l| l.starts_with("  ") && !l.trim_start().starts_with('-'))
+            .filter_map(|l| l.split_whitespace().next())
+            .collect();
+        let mut names: Vec<String> = Cli::command()
+            .get_subcommands()
+            .map(|c| c.get_name().to_string())
+            .collect();
+        names.sort();
+        let mut sorted: Vec<String> = listed.iter().map(|s| s.to_string()).collect();
+        sorted.sort();
+        assert_eq!(sorted, names, "listed: {listed:?}");
     }
 }

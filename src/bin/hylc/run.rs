@@ -1,9 +1,8 @@
 //! `hylc run`: the main job end to end (`hylc::workflow::pipeline`), printed as it goes, with a progress bar for
 //! the drape.
 
-use crate::args::{ConstructionArg, YarnArgs};
+use crate::args::{ConstructionArg, PresetArg, YarnArgs};
 use crate::printer::Printer;
-use hylc::fit::FitOptions;
 use hylc::workflow::pipeline::{self, RunConfig};
 use hylc::workflow::simulate::diverged;
 use std::path::PathBuf;
@@ -44,10 +43,10 @@ pub struct Args {
     /// delete the output folder first instead of resuming
     #[arg(long)]
     fresh: bool,
-    /// fit with the design's settings (those of `hylc fit` without options) instead of knots covering every
-    /// sample with the compressed half-plane's residual kept (the default here)
-    #[arg(long)]
-    design_fit: bool,
+    /// the fit's settings, as `hylc fit --preset` (docs/fitting.md, "Presets"): covering (knots over the
+    /// whole sampled range), design (the method's own, for dense plans) or design-stockinette
+    #[arg(long, value_enum, default_value = "covering")]
+    preset: PresetArg,
     #[command(flatten)]
     yarn: YarnArgs,
 }
@@ -64,11 +63,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         fresh: a.fresh,
         construction: a.construction.map(Into::into),
         yarn: a.yarn.material()?,
-        fit: if a.design_fit {
-            FitOptions::default()
-        } else {
-            FitOptions::covering()
-        },
+        fit: hylc::fit::FitPreset::from(a.preset).options(),
     };
     let mut printer = Printer::default();
     match pipeline::run(&config, &mut |e| printer.show(e)) {
