@@ -10,9 +10,10 @@ use common::cli_ok;
 use common::sampling::{by_id, dir};
 use hylc::generate::default_pattern;
 use hylc::micro::sensitivity::YarnParameter;
-use hylc::micro::{MicroProblem, SolverOptions};
+use hylc::micro::{MacroStrain, MicroProblem, SolverOptions};
 use hylc::rod::YarnMaterial;
-use hylc::sample::{read_samples, run_plan, Plan, Record, RunOptions};
+use hylc::sample::sensitivities::add_sensitivities;
+use hylc::sample::{read_samples, run_plan, Plan, Record, RunOptions, StartKind, Starts};
 use hylc::strain::StrainComponent::{Sa, Sx, Sy, II00, II11};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -223,6 +224,124 @@ fn step_study_of_the_resampled_differences() {
                 "{worst:?}"
             );
         }
+    }
+    std::fs::remove_dir_all(&d).ok();
+}
+
+/// The records of `path` by id, the two sensitivity fields removed.
+fn without_sensitivities(path: &Path) -> BTreeMap<String, Record> {
+    let mut r = by_id(read_samples(path, false).expect("read"));
+    for v in r.values_mut() {
+        v.dpsi_dtheta = None;
+        v.dstress_dtheta = None;
+    }
+    r
+}
+
+#[test]
+fn the_cli_writes_the_fields_only_with_the_flag_and_adds_missing_ones() {
+    let d = dir("sample-sensitivities", "cli");
+    let plan_file = d.join("plan.json");
+    std::fs::write(&plan_file, serde_json::to_string(&plan()).unwrap()).unwrap();
+    let (a, b) = (d.join("a.jsonl"), d.join("b.jsonl"));
+    let sample = |out: &Path, flag: bool| {
+        let mut args = vec!["sample", "plain", "--plan", plan_file.to_str().unwrap()];
+        args.extend(["--out", out.to_str().unwrap()]);
+        if flag {
+            args.push("--sensitivities");
+        }
+        String::from_utf8(cli_ok(&args).stdout).unwrap()
+    };
+    sample(&a, false);
+    sample(&b, true);
+    // without the flag: no new keys, and the records of the run with the flag otherwise
+    let text = std::fs::read_to_string(&a).unwrap();
+    assert!(!text.contains("dpsi_dtheta") && !text.contains("dstress_dtheta"));
+    assert_eq!(without_sensitivities(&a), without_sensitivities(&b));
+    // with it: every converged record has both, the keys in the order of the yarn parameters
+    let keys = YarnParameter::ALL.map(|p| format!("\"{}\":", p.name()));
+    for line in std::fs::read_to_string(&b).unwrap().lines() {
+        let r: Record = serde_json::from_str(line).unwrap();
+        assert!(r.converged_psi().is_some(), "{line}");
+        let (Some(_), Some(ds)) = (r.dpsi_dtheta, r.dstress_dtheta) else {
+            panic!("no sensitivities: {line}");
+        };
+        let at = line.find("\"dpsi_dtheta\":{").expect("dpsi_dtheta");
+        let pos: Vec<usize> = keys
+            .iter()
+            .map(|k| at + line[at..].find(k.as_str()).unwrap())
+            .collect();
+        assert!(pos.windows(2).all(|w| w[0] < w[1]), "{line}");
+        let stress = r.stress.unwrap();
+        for v in ds.to_array() {
+            assert!(
+                (0..5).all(|j| v[j].is_some() == stress[j].is_some()),
+                "{line}"
+            );
+        }
+    }
+    // the flag on the finished file without: the missing ones are added, equal to those of the run with it
+    let out = sample(&a, true);
+    let n = plan().len();
+    assert!(
+        out.contains(&format!("{n} of {n} finished records that lacked them")),
+        "{out}"
+    );
+    assert_eq!(
+        by_id(read_samples(&a, false).unwrap()),
+        by_id(read_samples(&b, false).unwrap())
+    );
+    // and again: nothing left to add, nothing re-solved
+    let out = sample(&a, true);
+    assert!(
+        out.contains("0 re-solved") && out.contains("0 of 0 finished"),
+        "{out}"
+    );
+    std::fs::remove_dir_all(&d).ok();
+}
+
+#[test]
+fn multi_start_records_get_the_sensitivities_of_the_kept_start() {
+    let d = dir("sample-sensitivities", "starts");
+    let p = problem(&base(), None);
+    let mut plan = plan();
+    plan.pairs.clear();
+    let opts = |starts| RunOptions {
+        starts,
+        sensitivities: true,
+        ..Default::default()
+    };
+    let warm = d.join("warm.jsonl");
+    run_plan(&p, &plan, &warm, &opts(Starts::Warm)).expect("run");
+    let warm = by_id(read_samples(&warm, false).unwrap());
+    for starts in [Starts::WarmCold, Starts::All] {
+        let f = d.join(format!("{starts}.jsonl"));
+        run_plan(&p, &plan, &f, &opts(starts)).expect("run");
+        let records = read_samples(&f, false).unwrap();
+        assert_eq!(records.len(), plan.len());
+        let mut cold = 0;
+        for r in &records {
+            assert!(r.dpsi_dtheta.is_some(), "{r:?}");
+            // the kept start's sensitivities: those of the warm run, or of a cold solve
+            let expected = match r.kept {
+                Some(StartKind::Warm) => warm[&r.id].clone(),
+                Some(StartKind::Cold) => {
+                    cold += 1;
+                    let sol = p.solve(&MacroStrain(r.z), None).unwrap();
+                    let mut e = r.clone();
+                    add_sensitivities(&p, &mut e, &sol.state).unwrap();
+                    e
+                }
+                other => panic!("{}: kept {other:?}", r.id),
+            };
+            assert_eq!(expected.dpsi_dtheta, r.dpsi_dtheta, "{starts} {}", r.id);
+            assert_eq!(
+                expected.dstress_dtheta, r.dstress_dtheta,
+                "{starts} {}",
+                r.id
+            );
+        }
+        assert!(cold > 0, "{starts}: no cold start kept");
     }
     std::fs::remove_dir_all(&d).ok();
 }
