@@ -18,7 +18,7 @@
 //! - Shards: shard k of n runs the chains with index ≡ k (mod n); [`merge`] concatenates shard files and removes
 //!   duplicate ids.
 
-use super::plan::{fnv1a64, Plan, Sample, Step};
+use super::plan::{fnv1a64, Chain, Plan, Sample, Step};
 use super::record::{Record, SampleStart, SampleStatus, StartKind};
 use super::sensitivities::{add_sensitivities, fill_file, lacks_sensitivities};
 use super::starts::{disagree, keep, kept_index, Solve, Starts, DEFAULT_DISAGREEMENT};
@@ -209,21 +209,7 @@ pub fn run_plan_with(
         .filter(|(c, _)| opts.shard.is_none_or(|(k, n)| c % n == k))
         .map(|(_, c)| c)
         .collect();
-    // --sensitivities: the finished records of the selected chains that lack them
-    let fill: HashMap<String, Record> = if opts.sensitivities {
-        let selected: HashSet<&str> = chains
-            .iter()
-            .flat_map(|c| &c.steps)
-            .map(|s| samples[s.sample].id.as_str())
-            .collect();
-        existing
-            .iter()
-            .filter(|r| lacks_sensitivities(r) && selected.contains(r.id.as_str()))
-            .map(|r| (r.id.clone(), r.clone()))
-            .collect()
-    } else {
-        HashMap::new()
-    };
+    let fill = lacking_sensitivities(opts, &existing, &chains, &samples);
     let done: HashSet<String> = existing.into_iter().map(|r| r.id).collect();
     let selected: usize = chains.iter().map(|c| c.steps.len()).sum();
     let already_done = chains
@@ -296,6 +282,29 @@ pub fn run_plan_with(
         sensitivities_added: added,
         time: t0.elapsed().as_secs_f64(),
     })
+}
+
+/// `--sensitivities`: the finished records of the selected chains that lack them ([`lacks_sensitivities`]), by id;
+/// none without the flag.
+fn lacking_sensitivities(
+    opts: &RunOptions,
+    existing: &[Record],
+    chains: &[Chain],
+    samples: &[Sample],
+) -> HashMap<String, Record> {
+    if !opts.sensitivities {
+        return HashMap::new();
+    }
+    let selected: HashSet<&str> = chains
+        .iter()
+        .flat_map(|c| &c.steps)
+        .map(|s| samples[s.sample].id.as_str())
+        .collect();
+    existing
+        .iter()
+        .filter(|r| lacks_sensitivities(r) && selected.contains(r.id.as_str()))
+        .map(|r| (r.id.clone(), r.clone()))
+        .collect()
 }
 
 /// The shared state of one [`run_plan_with`]: the inputs, the sample file and the counters the chains update.
