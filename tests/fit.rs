@@ -72,6 +72,8 @@ fn write_samples_of(
             starts: vec![],
             kept: None,
             crossings: None,
+            dpsi_dtheta: None,
+            dstress_dtheta: None,
         };
         text += &serde_json::to_string(&r).unwrap();
         text.push('\n');

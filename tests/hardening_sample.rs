@@ -50,6 +50,8 @@ fn records(plan: &Plan, truth: &Material) -> Vec<Record> {
                 starts: vec![],
                 kept: None,
                 crossings: None,
+                dpsi_dtheta: None,
+                dstress_dtheta: None,
             }
         })
         .collect()

@@ -13,6 +13,7 @@
 //! ρ = f r ([`PairKernel::radius_derivative`]), which is also how the contact radius factor f enters.
 
 use super::elimination::Elimination;
+use super::sensitivity::YarnParameter;
 use super::solver::{local, MicroError, MicroProblem, MicroState, Solution};
 use super::strain::Family;
 use super::surface::SurfaceMap;
@@ -113,8 +114,28 @@ pub fn parameter_derivatives(
         what: "parameter derivatives",
         source,
     })?;
+    derivatives_at(problem, &sol.state, Some(&sol.energy), sol.area)
+}
+
+/// [`parameter_derivatives`] at a state known to be a converged equilibrium (e.g. the kept state of a sample),
+/// the energy parts taken from the energies per unit parameter: E_s = Y e_s, E_b = γY e_b, E_t = γG e_t.
+pub fn parameter_derivatives_at(
+    problem: &MicroProblem,
+    state: &MicroState,
+) -> Result<[f64; 6], MicroError> {
+    let area = problem.pattern.periods[0] * problem.pattern.periods[1];
+    derivatives_at(problem, state, None, area)
+}
+
+/// The body of [`parameter_derivatives`]: `energy` the energy parts at the state (from the unit energies when
+/// `None`), `area` = p₁ p₂.
+fn derivatives_at(
+    problem: &MicroProblem,
+    state: &MicroState,
+    energy: Option<&crate::tile::EnergyParts>,
+    area: f64,
+) -> Result<[f64; 6], MicroError> {
     let p = &problem.pattern;
-    let state = &sol.state;
     let m = &problem.material;
     let elim = Elimination::in_family(p, &state.strain, state.family);
     let mut unit = m.clone();
@@ -145,7 +166,6 @@ pub fn parameter_derivatives(
             p.edges[pair.b].rest_length,
         )?;
     }
-    let e = &sol.energy;
     let (yg, g, ga, r, f) = (
         m.young,
         m.shear,
@@ -153,15 +173,60 @@ pub fn parameter_derivatives(
         p.radius,
         m.contact_radius_factor,
     );
-    let area = sol.area;
+    let (stretch, bend, twist) = match energy {
+        Some(e) => (e.stretch, e.bend, e.twist),
+        None => (yg * e1.stretch, ga * yg * e1.bend, ga * g * e1.twist),
+    };
     Ok([
         (e1.stretch + ga * e1.bend) / area,
         ga * e1.twist / area,
         (yg * e1.bend + g * e1.twist) / area,
         e1.contact / area,
         r * dc_dr / area,
-        (2.0 * e.stretch / r + 4.0 * (e.bend + e.twist) / r + f * dc_dr) / area,
+        (2.0 * stretch / r + 4.0 * (bend + twist) / r + f * dc_dr) / area,
     ])
+}
+
+/// The relative step of the directional differences of [`stress_parameter_derivatives`]: t_k = 1e-5 |θ_k|.
+pub const STRESS_PARAMETER_STEP: f64 = 1e-5;
+
+/// The total derivatives dσ/dθ_k of the stress σ = ∂Ψ̄/∂z ([`strain_derivatives`]) along the equilibrium, for
+/// every parameter of [`YarnParameter::ALL`], given dy*/dθ_k (`dy`, from
+/// [`equilibrium_sensitivities`](super::sensitivity::equilibrium_sensitivities)):
+///
+/// dσ/dθ_k = ∂σ/∂θ_k + (∂σ/∂y) dy*/dθ_k ≈ [σ(θ + t_k e_k, y* + t_k dy_k) − σ(θ − t_k e_k, y* − t_k dy_k)] / (2 t_k),
+///
+/// a central difference (t_k = [`STRESS_PARAMETER_STEP`] |θ_k|) of the analytic envelope stress at fixed stored
+/// frames along the line through the equilibrium in the direction of its first-order response. A component
+/// that [`strain_derivatives`] leaves `None` is `None`.
+pub fn stress_parameter_derivatives(
+    problem: &MicroProblem,
+    state: &MicroState,
+    dy: &[Vec<f64>],
+) -> Result<Vec<[Option<f64>; 5]>, MicroError> {
+    let mut out = Vec::with_capacity(YarnParameter::ALL.len());
+    for (param, d) in YarnParameter::ALL.iter().zip(dy) {
+        let v0 = param.get(&problem.material);
+        let t = STRESS_PARAMETER_STEP * v0.abs();
+        let at = |sign: f64| -> Result<[Option<f64>; 5], MicroError> {
+            let mut m = problem.material.clone();
+            param.set(&mut m, v0 + sign * t);
+            let mut pat = problem.pattern.clone();
+            if *param == YarnParameter::Radius {
+                pat.radius = v0 + sign * t;
+            }
+            let q = MicroProblem::new(pat, &m, problem.options.clone());
+            let mut s = state.clone();
+            s.y.iter_mut().zip(d).for_each(|(y, d)| *y += sign * t * d);
+            strain_derivatives(&q, &s)
+        };
+        let (plus, minus) = (at(1.0)?, at(-1.0)?);
+        out.push(std::array::from_fn(|j| match (plus[j], minus[j]) {
+            (Some(a), Some(b)) => Some((a - b) / (2.0 * t)),
+            _ => None,
+        }));
+    }
+    Ok(out)
 }
 
 /// Second derivatives of Ψ̄ with respect to the strain components of a state's family, and the sensitivity of

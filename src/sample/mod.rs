@@ -1,16 +1,18 @@
 //! Sampling (`docs/sampling.md`, section "Sampling plan (C4)"): plans ([`plan`]) and
 //! running them on one pattern ([`run`]): parallel warm-started chains, an append-only sample file of
-//! [`record`]s, resume, shards and merging, the starts of a multi-start sample ([`starts`]); plans derived from
-//! the strains a macro run visited ([`scene`]). Sibling modules import one way: `record` ← `starts` ← `run`.
+//! [`record`]s, resume, shards and merging, the starts of a multi-start sample ([`starts`]), per-sample
+//! sensitivities to the yarn parameters ([`sensitivities`]); plans derived from the strains a macro run visited
+//! ([`scene`]). Sibling modules import one way: `record` ← `starts`, `sensitivities` ← `run`.
 
 pub mod plan;
 pub mod record;
 pub mod run;
 pub mod scene;
+pub mod sensitivities;
 pub mod starts;
 
 pub use plan::{sample_range, Chain, InPlaneGrid, Plan, PlanError, Sample, Step};
-pub use record::{Record, SampleStart, SampleStatus, StartKind, StartResult};
+pub use record::{PerParameter, Record, SampleStart, SampleStatus, StartKind, StartResult};
 pub use run::{merge, parse_shard, read_samples, run_plan, run_plan_with, RunOptions, RunSummary};
 pub use starts::{compare, Comparison, Disagreement, Starts};
 

@@ -2,6 +2,7 @@
 //! of a multi-start sample ([`StartResult`]). The run ([`super::run`]) writes them, the multi-start rules
 //! ([`super::starts`]) combine them, `read_samples` and the fit read them.
 
+use crate::micro::sensitivity::YarnParameter;
 use crate::micro::Status;
 use serde::{Deserialize, Serialize};
 
@@ -47,9 +48,74 @@ pub struct Record {
     /// ([`Record::converged_psi`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crossings: Option<usize>,
+    /// ∂Ψ̄/∂θ (J/m² per unit of each yarn parameter: Y and G in Pa, γ and f dimensionless, k_c in J/m², r in m) at
+    /// the kept equilibrium, the reference state held fixed (`--sensitivities`; omitted otherwise, and on records
+    /// that do not count as converged).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dpsi_dtheta: Option<PerParameter<f64>>,
+    /// dσ/dθ, the total derivative of the record's `stress` along the equilibrium, per parameter the five strain
+    /// components in the order of `z` (J/m² per unit strain per unit parameter; null where the stress component is
+    /// null). Present with `dpsi_dtheta` where the record has a stress.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dstress_dtheta: Option<PerParameter<[Option<f64>; 5]>>,
+}
+
+/// One value per yarn parameter, serialised as an object with the keys of the yarn JSON in the fixed order of
+/// [`YarnParameter::ALL`]: `young`, `shear`, `bend_twist_factor`, `contact_stiffness`, `contact_radius_factor`,
+/// `radius`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PerParameter<T> {
+    pub young: T,
+    pub shear: T,
+    pub bend_twist_factor: T,
+    pub contact_stiffness: T,
+    pub contact_radius_factor: T,
+    pub radius: T,
+}
+
+impl<T: Copy> PerParameter<T> {
+    /// From the values in the order of [`YarnParameter::ALL`].
+    pub fn from_array(v: [T; 6]) -> Self {
+        PerParameter {
+            young: v[0],
+            shear: v[1],
+            bend_twist_factor: v[2],
+            contact_stiffness: v[3],
+            contact_radius_factor: v[4],
+            radius: v[5],
+        }
+    }
+
+    /// The values in the order of [`YarnParameter::ALL`].
+    pub fn to_array(&self) -> [T; 6] {
+        [
+            self.young,
+            self.shear,
+            self.bend_twist_factor,
+            self.contact_stiffness,
+            self.contact_radius_factor,
+            self.radius,
+        ]
+    }
+
+    /// The value of one parameter.
+    pub fn get(&self, p: YarnParameter) -> T {
+        self.to_array()[YarnParameter::ALL
+            .iter()
+            .position(|q| *q == p)
+            .expect("every parameter is in ALL")]
+    }
 }
 
 impl Record {
+    /// The record as one line of JSON (with its newline), as a sample file holds it.
+    pub fn to_line(&self) -> String {
+        serde_json::to_string(self)
+            .expect("sample records serialise (string keys, no custom serialisers)")
+            + "\n"
+    }
+
     /// The same solve result as `other` (strain, status, Ψ̄ bitwise, stress): a repeated id with another result
     /// is a conflict that `merge` and `fit` refuse.
     pub fn same_result(&self, other: &Record) -> bool {

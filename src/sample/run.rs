@@ -18,8 +18,9 @@
 //! - Shards: shard k of n runs the chains with index ≡ k (mod n); [`merge`] concatenates shard files and removes
 //!   duplicate ids.
 
-use super::plan::{fnv1a64, Plan, Sample, Step};
+use super::plan::{fnv1a64, Chain, Plan, Sample, Step};
 use super::record::{Record, SampleStart, SampleStatus, StartKind};
+use super::sensitivities::{add_sensitivities, fill_file, lacks_sensitivities};
 use super::starts::{disagree, keep, kept_index, Solve, Starts, DEFAULT_DISAGREEMENT};
 use super::SampleError;
 use crate::contact::ccd::{net_crossings, Crossing};
@@ -50,6 +51,10 @@ pub struct RunOptions {
     /// `Starts::All`: the relative difference of the warm and the cold Ψ̄ above which the reversed chain is tried
     /// too ([`super::starts::DEFAULT_DISAGREEMENT`] when `None`).
     pub disagreement: Option<f64>,
+    /// Store ∂Ψ̄/∂θ and dσ/dθ in every record that counts as converged ([`super::sensitivities`]), and add them
+    /// to the finished records of the selected chains that lack them (re-solving their chains; the file is then
+    /// rewritten).
+    pub sensitivities: bool,
 }
 
 /// What a run did.
@@ -63,8 +68,15 @@ pub struct RunSummary {
     pub written: usize,
     /// Of these, converged.
     pub converged: usize,
-    /// Solves redone (not written) to recover warm-start states of finished samples.
+    /// Solves redone (not written) to recover warm-start states of finished samples (or, with
+    /// [`RunOptions::sensitivities`], their sensitivities).
     pub replayed: usize,
+    /// Records written by this run with sensitivities ([`RunOptions::sensitivities`]).
+    pub sensitivities: usize,
+    /// Finished records of the selected chains that lacked sensitivities, and of these the ones given them (the
+    /// others were re-solved to another result, or their sensitivities could not be computed).
+    pub lacking_sensitivities: usize,
+    pub sensitivities_added: usize,
     /// Wall time (s).
     pub time: f64,
 }
@@ -146,9 +158,7 @@ pub fn read_samples(path: &Path, repair: bool) -> Result<Vec<Record>, SampleErro
 
 /// A record as one line of JSON (with its newline).
 fn record_line(record: &Record) -> String {
-    serde_json::to_string(record)
-        .expect("sample records serialise (string keys, no custom serialisers)")
-        + "\n"
+    record.to_line()
 }
 
 /// Run `plan` on `problem`, appending to the sample file `out` (created if missing; finished ids skipped).
@@ -191,7 +201,6 @@ pub fn run_plan_with(
             ),
         });
     }
-    let done: HashSet<String> = existing.into_iter().map(|r| r.id).collect();
     let samples = plan.samples();
     let chains: Vec<_> = plan
         .chains()
@@ -200,6 +209,8 @@ pub fn run_plan_with(
         .filter(|(c, _)| opts.shard.is_none_or(|(k, n)| c % n == k))
         .map(|(_, c)| c)
         .collect();
+    let fill = lacking_sensitivities(opts, &existing, &chains, &samples);
+    let done: HashSet<String> = existing.into_iter().map(|r| r.id).collect();
     let selected: usize = chains.iter().map(|c| c.steps.len()).sum();
     let already_done = chains
         .iter()
@@ -222,6 +233,9 @@ pub fn run_plan_with(
         problem,
         samples: &samples,
         done: &done,
+        fill: &fill,
+        filled: Mutex::new(HashMap::new()),
+        with_sensitivities: AtomicUsize::new(0),
         opts,
         hash: &hash,
         out,
@@ -237,17 +251,60 @@ pub fn run_plan_with(
     };
     progress(0, todo);
     chains.par_iter().for_each(|chain| run.chain(&chain.steps));
-    if let Some(e) = run.failure.into_inner().ok().flatten() {
+    let PlanRun {
+        file,
+        failure,
+        filled,
+        written,
+        converged,
+        replayed,
+        with_sensitivities,
+        ..
+    } = run;
+    drop(file);
+    if let Some(e) = failure.into_inner().ok().flatten() {
         return Err(e);
     }
+    let filled = filled.into_inner().unwrap_or_default();
+    let added = if filled.is_empty() {
+        0
+    } else {
+        fill_file(out, &filled)?
+    };
     Ok(RunSummary {
         selected,
         already_done,
-        written: run.written.into_inner(),
-        converged: run.converged.into_inner(),
-        replayed: run.replayed.into_inner(),
+        written: written.into_inner(),
+        converged: converged.into_inner(),
+        replayed: replayed.into_inner(),
+        sensitivities: with_sensitivities.into_inner(),
+        lacking_sensitivities: fill.len(),
+        sensitivities_added: added,
         time: t0.elapsed().as_secs_f64(),
     })
+}
+
+/// `--sensitivities`: the finished records of the selected chains that lack them ([`lacks_sensitivities`]), by id;
+/// none without the flag.
+fn lacking_sensitivities(
+    opts: &RunOptions,
+    existing: &[Record],
+    chains: &[Chain],
+    samples: &[Sample],
+) -> HashMap<String, Record> {
+    if !opts.sensitivities {
+        return HashMap::new();
+    }
+    let selected: HashSet<&str> = chains
+        .iter()
+        .flat_map(|c| &c.steps)
+        .map(|s| samples[s.sample].id.as_str())
+        .collect();
+    existing
+        .iter()
+        .filter(|r| lacks_sensitivities(r) && selected.contains(r.id.as_str()))
+        .map(|r| (r.id.clone(), r.clone()))
+        .collect()
 }
 
 /// The shared state of one [`run_plan_with`]: the inputs, the sample file and the counters the chains update.
@@ -256,6 +313,12 @@ pub(super) struct PlanRun<'a> {
     pub(super) samples: &'a [Sample],
     /// Ids already in the sample file.
     pub(super) done: &'a HashSet<String>,
+    /// `--sensitivities`: the finished records that lack them, by id.
+    fill: &'a HashMap<String, Record>,
+    /// Of these, the ones re-solved to the same result, with their sensitivities.
+    filled: Mutex<HashMap<String, Record>>,
+    /// Records written with sensitivities.
+    with_sensitivities: AtomicUsize,
     pub(super) opts: &'a RunOptions,
     hash: &'a str,
     out: &'a Path,
@@ -281,7 +344,10 @@ impl PlanRun<'_> {
         }
         let mut need: Vec<bool> = steps
             .iter()
-            .map(|s| !self.done.contains(&self.samples[s.sample].id))
+            .map(|s| {
+                let id = &self.samples[s.sample].id;
+                !self.done.contains(id) || self.fill.contains_key(id)
+            })
             .collect();
         if !self.opts.cold {
             for i in (0..steps.len()).rev() {
@@ -312,24 +378,58 @@ impl PlanRun<'_> {
             states[i] = state;
             // warm+cold: the cold start too, unless the chain's start was cold already (no converged step up
             // the chain); only the record changes, the chain continues from its warm equilibria
+            let mut cold_state = None;
             let record = match self.opts.starts {
                 Starts::Warm | Starts::All => record,
                 Starts::WarmCold if record.start == SampleStart::Cold => {
                     keep(vec![(StartKind::Cold, record)])
                 }
                 Starts::WarmCold => {
-                    let (cold, _) = self.solve(steps, step, &states, sample, true);
+                    let (cold, cs) = self.solve(steps, step, &states, sample, true);
+                    cold_state = cs;
                     keep(vec![(StartKind::Warm, record), (StartKind::Cold, cold)])
                 }
             };
-            if write {
-                if !self.write(&record) {
-                    break;
-                }
-            } else {
-                self.replayed.fetch_add(1, Ordering::Relaxed);
+            let kept = match (record.kept, cold_state.as_ref()) {
+                (Some(StartKind::Cold), Some(cs)) => Some(cs),
+                _ => states[i].as_ref(),
+            };
+            if !self.finish(record, kept, write) {
+                break;
             }
         }
+    }
+
+    /// A sample's final record with its kept state: written when `write` (with sensitivities when asked), else
+    /// counted as replayed and, when it is a finished record that lacks sensitivities, given them for the rewrite
+    /// if it was re-solved to the same result ([`Record::same_result`]). False when the run must stop.
+    pub(super) fn finish(
+        &self,
+        mut record: Record,
+        kept: Option<&MicroState>,
+        write: bool,
+    ) -> bool {
+        let stored = self.fill.get(&record.id).filter(|_| !write);
+        let wanted = self.opts.sensitivities
+            && record.converged_psi().is_some()
+            && (write || stored.is_some_and(|s| s.same_result(&record)));
+        if let Some(state) = kept.filter(|_| wanted) {
+            // a failure leaves the record without sensitivities (a resume with the flag tries again)
+            let _ = add_sensitivities(self.problem, &mut record, state);
+        }
+        if write {
+            if record.dpsi_dtheta.is_some() {
+                self.with_sensitivities.fetch_add(1, Ordering::Relaxed);
+            }
+            return self.write(&record);
+        }
+        self.replayed.fetch_add(1, Ordering::Relaxed);
+        if record.dpsi_dtheta.is_some() {
+            if let Ok(mut f) = self.filled.lock() {
+                f.insert(record.id.clone(), record);
+            }
+        }
+        true
     }
 
     /// Solve one step from its start (secant prediction, warm or cold); the record, and the state when converged.
@@ -442,6 +542,8 @@ impl PlanRun<'_> {
             starts: vec![],
             kept: None,
             crossings: None,
+            dpsi_dtheta: None,
+            dstress_dtheta: None,
         };
         match problem.solve(&strain, start) {
             Ok(sol) => {
@@ -510,7 +612,7 @@ impl PlanRun<'_> {
     /// then the chain's unfinished records in order.
     pub(super) fn chain_all(&self, steps: &[Step]) {
         let id = |i: usize| &self.samples[steps[i].sample].id;
-        if (0..steps.len()).all(|i| self.done.contains(id(i))) {
+        if (0..steps.len()).all(|i| self.done.contains(id(i)) && !self.fill.contains_key(id(i))) {
             return;
         }
         let rel = self.opts.disagreement.unwrap_or(DEFAULT_DISAGREEMENT);
@@ -551,20 +653,18 @@ impl PlanRun<'_> {
             kept[i] = solves[i][k].2.clone();
         }
         for (i, v) in solves.into_iter().enumerate() {
-            if self.done.contains(id(i)) {
-                self.replayed.fetch_add(1, Ordering::Relaxed);
-                continue;
-            }
-            if self
-                .opts
-                .limit
-                .is_some_and(|l| self.slots.fetch_add(1, Ordering::SeqCst) >= l)
+            let write = !self.done.contains(id(i));
+            if write
+                && self
+                    .opts
+                    .limit
+                    .is_some_and(|l| self.slots.fetch_add(1, Ordering::SeqCst) >= l)
             {
                 self.stop.store(true, Ordering::Relaxed);
                 return;
             }
             let record = keep(v.into_iter().map(|(k, r, _)| (k, r)).collect());
-            if !self.write(&record) {
+            if !self.finish(record, kept[i].as_ref(), write) {
                 return;
             }
         }
@@ -572,7 +672,8 @@ impl PlanRun<'_> {
 }
 
 /// Merge sample files (e.g. shards) into `out`: all records, ordered by plan index then id; a repeated id with the
-/// same result ([`Record::same_result`]) is dropped, with another result it is an error naming the file and id.
+/// same result ([`Record::same_result`]) is dropped (the copy with sensitivities kept where only one has them),
+/// with another result it is an error naming the file and id.
 /// Returns (records written, duplicates dropped). `out` is written to a temporary file and renamed.
 pub fn merge(out: &Path, inputs: &[&Path]) -> Result<(usize, usize), SampleError> {
     let mut seen: HashMap<String, usize> = HashMap::new();
@@ -585,7 +686,13 @@ pub fn merge(out: &Path, inputs: &[&Path]) -> Result<(usize, usize), SampleError
                     seen.insert(r.id.clone(), records.len());
                     records.push(r);
                 }
-                Some(&k) if records[k].same_result(&r) => duplicates += 1,
+                Some(&k) if records[k].same_result(&r) => {
+                    // the copy with sensitivities, if only one has them
+                    if records[k].dpsi_dtheta.is_none() && r.dpsi_dtheta.is_some() {
+                        records[k] = r;
+                    }
+                    duplicates += 1
+                }
                 Some(&k) => {
                     return Err(SampleError::File {
                         path: path.to_path_buf(),
@@ -670,6 +777,8 @@ mod tests {
             starts: vec![],
             kept: None,
             crossings: None,
+            dpsi_dtheta: None,
+            dstress_dtheta: None,
         };
         let line = serde_json::to_string(&r).unwrap();
         std::fs::write(&path, format!("{line}\n{}", &line[..20])).unwrap();
@@ -703,6 +812,8 @@ mod tests {
             starts: vec![],
             kept: None,
             crossings: None,
+            dpsi_dtheta: None,
+            dstress_dtheta: None,
         };
         std::fs::write(&path, format!("\u{feff}{}", record_line(&r))).unwrap();
         assert_eq!(read_samples(&path, true).unwrap(), vec![r.clone()]);

@@ -203,6 +203,8 @@ mod tests {
             starts: vec![],
             kept: None,
             crossings: None,
+            dpsi_dtheta: None,
+            dstress_dtheta: None,
         }
     }
 

@@ -285,6 +285,8 @@ fn sample_seed() -> String {
             starts: vec![],
             kept: None,
             crossings: None,
+            dpsi_dtheta: None,
+            dstress_dtheta: None,
         };
         text += &serde_json::to_string(&r).unwrap_or_default();
         text.push('\n');

@@ -465,6 +465,7 @@ fn stage_sample(args: &RunConfig, dir: &Path, log: &mut Log) -> Result<Sampled, 
         predictor: Default::default(),
         starts: Default::default(),
         disagreement: None,
+        sensitivities: false,
     };
     let sp = log.sample(&problem, &plan, &samples, &opts)?;
     write_meta(&holdout, &ref_arg, &hplan, &problem)?;

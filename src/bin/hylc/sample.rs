@@ -46,6 +46,10 @@ pub struct Args {
     /// --starts all: relative difference of the warm and the cold Ψ̄ above which the reversed chain is tried
     #[arg(long, default_value_t = hylc::sample::starts::DEFAULT_DISAGREEMENT)]
     disagreement: f64,
+    /// store ∂Ψ̄/∂θ and dσ/dθ for the six yarn parameters in every converged record (`dpsi_dtheta`,
+    /// `dstress_dtheta`); on a finished file, add them to the records that lack them
+    #[arg(long)]
+    sensitivities: bool,
     #[command(flatten)]
     solver: SolverArgs,
     #[command(flatten)]
@@ -96,6 +100,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         predictor: a.predictor.into(),
         starts,
         disagreement: Some(a.disagreement),
+        sensitivities: a.sensitivities,
     };
     let bar = OnceLock::new();
     let progress = |done: usize, todo: usize| {
@@ -120,5 +125,11 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         s.replayed,
         s.time
     );
+    if a.sensitivities {
+        println!(
+            "sensitivities: {} written records, {} of {} finished records that lacked them",
+            s.sensitivities, s.sensitivities_added, s.lacking_sensitivities
+        );
+    }
     Ok(exit(s.written == s.converged, 3))
 }
