@@ -23,7 +23,8 @@
 //! slightly off the knot).
 
 use super::mls::{Mls1D, DEFAULT_BANDWIDTH_FACTOR};
-use super::symlog::{symexp, symlog_samples};
+use super::scalar::{linear, FitScalar, KinkRule, Kinks};
+use super::symlog::{symexp_t, symlog_samples_t};
 use super::FitError;
 use crate::material::Hermite1D;
 
@@ -160,31 +161,37 @@ fn check_inputs(
     check_options(opts)
 }
 
-/// Step 1: g(u) = symexp(MLS(u | X, symlog Ψ)), ε = `eps_rel` · max|Ψ|, symmetrised MLS for s_a.
-struct Smoothed {
+/// Step 1: g(u) = symexp(MLS(u | X, symlog Ψ)), ε = `eps_rel` · max|Ψ|, symmetrised MLS for s_a. The MLS is
+/// linear in the transformed values (the weights depend on X only), so it is applied to each part of them.
+struct Smoothed<T> {
     mls: Mls1D,
-    eps: f64,
+    logs: Vec<Vec<f64>>,
+    eps: T,
     symmetric: bool,
 }
 
-impl Smoothed {
-    fn new(xs: &[f64], ys: &[f64], opts: &Fit1DOptions) -> Result<Self, FitError> {
-        let (eps, logs) = symlog_samples(ys, opts.eps_rel);
-        let mls = Mls1D::new(xs, &logs, opts.bandwidth_factor)?;
+impl<T: FitScalar> Smoothed<T> {
+    fn new(xs: &[f64], ys: &[T], opts: &Fit1DOptions, kinks: &mut Kinks) -> Result<Self, FitError> {
+        let (eps, logs) = symlog_samples_t(ys, opts.eps_rel, kinks, |i| {
+            format!("sample at X = {}", xs[i])
+        });
+        let re: Vec<f64> = logs.iter().map(|v| v.value()).collect();
+        let mls = Mls1D::new(xs, &re, opts.bandwidth_factor)?;
         Ok(Smoothed {
             mls,
+            logs: T::parts(&logs),
             eps,
             symmetric: opts.symmetric,
         })
     }
 
-    fn g(&self, u: f64) -> f64 {
-        let w = if self.symmetric {
-            self.mls.eval_symmetric(u)
+    fn g(&self, u: f64) -> T {
+        let w: T = if self.symmetric {
+            linear(&self.logs, |y| self.mls.eval_symmetric_with(u, y))
         } else {
-            self.mls.eval(u)
+            linear(&self.logs, |y| self.mls.eval_with(u, y))
         };
-        symexp(w, self.eps)
+        symexp_t(w, self.eps)
     }
 }
 
@@ -217,7 +224,13 @@ impl Knots {
 
     /// Step 3's i_min: the knot at 0 ([`MinimumAt::Zero`]; an error when there is none, the samples spanning
     /// [lo, hi]) or the knot with the smallest value `p` ([`MinimumAt::Argmin`]).
-    fn minimum(&self, rule: MinimumAt, p: &[f64], lo: f64, hi: f64) -> Result<usize, FitError> {
+    fn minimum<T: FitScalar>(
+        &self,
+        rule: MinimumAt,
+        p: &[T],
+        (lo, hi): (f64, f64),
+        kinks: &mut Kinks,
+    ) -> Result<usize, FitError> {
         Ok(match rule {
             MinimumAt::Zero => {
                 if self.k_lo > 0 || self.k_hi < 0 {
@@ -227,34 +240,57 @@ impl Knots {
                 }
                 (-self.k_lo) as usize
             }
-            MinimumAt::Argmin => (0..self.t.len()).fold(0, |b, i| if p[i] < p[b] { i } else { b }),
+            MinimumAt::Argmin => {
+                let b = (0..self.t.len()).fold(
+                    0,
+                    |b, i| {
+                        if p[i].value() < p[b].value() {
+                            i
+                        } else {
+                            b
+                        }
+                    },
+                );
+                for i in (0..p.len()).filter(|&i| i != b) {
+                    kinks.tie(p[i], p[b], KinkRule::MinimumKnot, || {
+                        format!("knots {b} and {i}")
+                    });
+                }
+                b
+            }
         })
     }
 }
 
 /// Step 2's slopes at the knots `t`: the MLS of the sampled stresses (its odd part for s_a) when
 /// [`SlopeSource::Stress`], else central differences of g with step `d`.
-fn knot_slopes(
-    g: &Smoothed,
+fn knot_slopes<T: FitScalar>(
+    g: &Smoothed<T>,
     t: &[f64],
     d: f64,
-    (x, psi, stress): (&[f64], &[f64], Option<&[f64]>),
+    (x, psi, stress): (&[f64], &[T], Option<&[T]>),
     opts: &Fit1DOptions,
-) -> Result<Vec<f64>, FitError> {
+) -> Result<Vec<T>, FitError> {
     Ok(match (opts.slopes, stress) {
         (SlopeSource::Stress, Some(st)) => {
-            let (sx, sy): (Vec<f64>, Vec<f64>) = (0..x.len())
-                .filter(|&i| x[i].is_finite() && psi[i].is_finite() && st[i].is_finite())
+            let (sx, sy): (Vec<f64>, Vec<T>) = (0..x.len())
+                .filter(|&i| {
+                    x[i].is_finite() && psi[i].value().is_finite() && st[i].value().is_finite()
+                })
                 .map(|i| (x[i], st[i]))
                 .unzip();
-            let ms = Mls1D::new(&sx, &sy, opts.bandwidth_factor)?;
+            let re: Vec<f64> = sy.iter().map(|v| v.value()).collect();
+            let ms = Mls1D::new(&sx, &re, opts.bandwidth_factor)?;
+            let parts = T::parts(&sy);
             t.iter()
                 .map(|&u| {
-                    if opts.symmetric {
-                        0.5 * (ms.eval(u) - ms.eval(-u))
-                    } else {
-                        ms.eval(u)
-                    }
+                    linear(&parts, |y| {
+                        if opts.symmetric {
+                            0.5 * (ms.eval_with(u, y) - ms.eval_with(-u, y))
+                        } else {
+                            ms.eval_with(u, y)
+                        }
+                    })
                 })
                 .collect()
         }
@@ -267,41 +303,68 @@ fn knot_slopes(
 
 /// Step 3: quasi-convexify outward from i_min, p_{i+1} ≥ pᵢ + (t_{i+1} − tᵢ) pˣ_min and pˣᵢ ≥ pˣ_min on the
 /// right, mirrored on the left; the slope at i_min is set to 0 when `flat_minimum` (the in-plane strains).
-fn quasi_convexify(
+fn quasi_convexify<T: FitScalar>(
     t: &[f64],
-    p: &mut [f64],
-    m: &mut [f64],
+    (p, m): (&mut [T], &mut [T]),
     i_min: usize,
-    pmin: f64,
-    flat_minimum: bool,
+    (pmin, flat_minimum): (f64, bool),
+    kinks: &mut Kinks,
 ) {
     let n = t.len();
     if flat_minimum {
-        m[i_min] = 0.0;
+        m[i_min] = T::from(0.0);
     }
+    let knot = |i: usize| move || format!("knot {i}");
+    let bound = T::from(pmin);
     for i in i_min + 1..n {
-        p[i] = p[i].max(p[i - 1] + (t[i] - t[i - 1]) * pmin);
-        m[i] = m[i].max(pmin);
+        p[i] = kinks.max(
+            p[i],
+            p[i - 1] + (t[i] - t[i - 1]) * pmin,
+            KinkRule::QuasiConvexValue,
+            knot(i),
+        );
+        m[i] = kinks.max(m[i], bound, KinkRule::QuasiConvexSlope, knot(i));
     }
     for i in (0..i_min).rev() {
-        p[i] = p[i].max(p[i + 1] + (t[i + 1] - t[i]) * pmin);
-        m[i] = m[i].min(-pmin);
+        p[i] = kinks.max(
+            p[i],
+            p[i + 1] + (t[i + 1] - t[i]) * pmin,
+            KinkRule::QuasiConvexValue,
+            knot(i),
+        );
+        m[i] = kinks.min(m[i], -bound, KinkRule::QuasiConvexSlope, knot(i));
     }
 }
 
 /// Steps 5 and 4 (5 first: 4 never changes a slope's sign or lowers |slope| below 3 pˣ_min): the end slopes rise
 /// outward, then Fritsch–Carlson, 0 ≤ α, β ≤ 3 on every cell, sides of i_min separately.
-fn limit_slopes(t: &[f64], p: &[f64], m: &mut [f64], pmin: f64) {
+fn limit_slopes<T: FitScalar>(t: &[f64], p: &[T], m: &mut [T], pmin: f64, kinks: &mut Kinks) {
     let n = t.len();
-    m[n - 1] = m[n - 1].max(pmin);
-    m[0] = m[0].min(-pmin);
+    let bound = T::from(pmin);
+    m[n - 1] = kinks.max(m[n - 1], bound, KinkRule::EndSlope, || {
+        format!("knot {}", n - 1)
+    });
+    m[0] = kinks.min(m[0], -bound, KinkRule::EndSlope, || "knot 0".into());
     for c in 0..n - 1 {
         let secant = (p[c + 1] - p[c]) / (t[c + 1] - t[c]);
-        let cap = 3.0 * secant.abs();
+        let cap = secant.copysign_of(1.0) * 3.0;
         for i in [c, c + 1] {
+            let site = || format!("knot {i}, cell {c}");
             // limit only slopes pointing the way the cell goes; the (−, +) cell at i_min is left as it is
-            if m[i] * secant > 0.0 && m[i].abs() > cap {
-                m[i] = cap.copysign(m[i]);
+            let (mi, s) = (m[i].value(), secant.value());
+            if mi.abs() > cap.value() {
+                kinks.tie(p[c + 1], p[c], KinkRule::FritschCarlsonSign, site);
+            }
+            if mi * s > 0.0 {
+                kinks.tie(
+                    m[i].copysign_of(1.0),
+                    cap,
+                    KinkRule::FritschCarlsonCap,
+                    site,
+                );
+            }
+            if mi * s > 0.0 && mi.abs() > cap.value() {
+                m[i] = cap.copysign_of(mi);
             }
         }
     }
@@ -309,15 +372,98 @@ fn limit_slopes(t: &[f64], p: &[f64], m: &mut [f64], pmin: f64) {
 
 /// Step 6: the spline minus its value f(0), and f(0) (taken exactly at the knot 0, always there for in-plane
 /// strains, else evaluated, extrapolating).
-fn residual_form(spline: Hermite1D) -> (Hermite1D, f64) {
-    let offset = match spline.t.iter().position(|&v| v == 0.0) {
-        Some(i) => spline.p[i],
-        None => spline.eval2(0.0)[0],
+fn residual_form<T: FitScalar>(t: &[f64], p: &mut [T], m: &[T]) -> T {
+    let offset = match t.iter().position(|&v| v == 0.0) {
+        Some(i) => p[i],
+        None => {
+            let n = t.len();
+            let pm: Vec<T> = p.iter().chain(m).copied().collect();
+            linear(&T::parts(&pm), |c| {
+                Hermite1D::new(t.to_vec(), c[..n].to_vec(), c[n..].to_vec()).eval2(0.0)[0]
+            })
+        }
     };
-    let t = spline.t.clone();
-    let p: Vec<f64> = spline.p.iter().map(|v| v - offset).collect();
-    let m = spline.m.clone();
-    (Hermite1D::new(t, p, m), offset)
+    for v in p.iter_mut() {
+        *v -= offset;
+    }
+    offset
+}
+
+/// FIT1D steps 1–6 over a [`FitScalar`] (the knots, i_min and every branch decided on the real parts; `kinks`
+/// records the decisions at their switching points).
+pub(crate) struct Core1D<T> {
+    pub(crate) t: Vec<f64>,
+    pub(crate) p: Vec<T>,
+    pub(crate) m: Vec<T>,
+    pub(crate) offset: T,
+    i_min: usize,
+    /// the usable samples (X, real Ψ) and how many were excluded
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+    n_excluded: usize,
+    g: Smoothed<T>,
+    range: (f64, f64),
+}
+
+/// The core of [`fit1d_with_stress`] on scalars `psi` and `stress` (inputs checked by the caller).
+pub(crate) fn fit1d_core<T: FitScalar>(
+    x: &[f64],
+    psi: &[T],
+    stress: Option<&[T]>,
+    opts: &Fit1DOptions,
+    kinks: &mut Kinks,
+) -> Result<Core1D<T>, FitError> {
+    let (xs, ys): (Vec<f64>, Vec<T>) = x
+        .iter()
+        .zip(psi)
+        .filter(|(a, b)| a.is_finite() && b.value().is_finite())
+        .map(|(&a, &b)| (a, b))
+        .unzip();
+    let n_excluded = x.len() - xs.len();
+
+    // step 1: g = symexp ∘ MLS ∘ symlog
+    let g = Smoothed::new(&xs, &ys, opts, kinks)?;
+
+    // step 2: knots at multiples of h inside [0.95 min X, 0.95 max X], p = g(t), slopes
+    let (lo, hi) = xs
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
+            (l.min(v), h.max(v))
+        });
+    let knots = Knots::new(lo, hi, opts.n_knots, opts.extent)?;
+    let t = knots.t.clone();
+    let mut p: Vec<T> = t.iter().map(|&u| g.g(u)).collect();
+    let d = opts.fd_step * knots.h;
+    let mut m = knot_slopes(&g, &t, d, (x, psi, stress), opts)?;
+    if p.iter().chain(&m).any(|v| !v.value().is_finite()) {
+        return Err(FitError::BadOption(
+            "the MLS curve overflowed (Ψ too large for symexp)".into(),
+        ));
+    }
+
+    // step 3: quasi-convexify outward from i_min
+    let i_min = knots.minimum(opts.minimum, &p, (lo, hi), kinks)?;
+    let pmin = opts.min_slope;
+    let flat = opts.minimum == MinimumAt::Zero;
+    quasi_convexify(&t, (&mut p, &mut m), i_min, (pmin, flat), kinks);
+
+    // steps 5 and 4: end slopes, Fritsch–Carlson
+    limit_slopes(&t, &p, &mut m, pmin, kinks);
+
+    // step 6: residual form
+    let offset = residual_form(&t, &mut p, &m);
+    Ok(Core1D {
+        t,
+        p,
+        m,
+        offset,
+        i_min,
+        xs,
+        ys: ys.iter().map(|v| v.value()).collect(),
+        n_excluded,
+        g,
+        range: (lo, hi),
+    })
 }
 
 /// [`fit1d`] with the sampled stresses dΨ/dX (same length as `x`; non-finite entries are dropped with their
@@ -330,57 +476,16 @@ pub fn fit1d_with_stress(
     opts: &Fit1DOptions,
 ) -> Result<Fit1D, FitError> {
     check_inputs(x, psi, stress, opts)?;
-    let (xs, ys): (Vec<f64>, Vec<f64>) = x
-        .iter()
-        .zip(psi)
-        .filter(|(a, b)| a.is_finite() && b.is_finite())
-        .map(|(&a, &b)| (a, b))
-        .unzip();
-    let n_excluded = x.len() - xs.len();
-
-    // step 1: g = symexp ∘ MLS ∘ symlog
-    let g = Smoothed::new(&xs, &ys, opts)?;
-
-    // step 2: knots at multiples of h inside [0.95 min X, 0.95 max X], p = g(t), slopes
-    let (lo, hi) = xs
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
-            (l.min(v), h.max(v))
-        });
-    let knots = Knots::new(lo, hi, opts.n_knots, opts.extent)?;
+    let core = fit1d_core(x, psi, stress, opts, &mut Kinks::off())?;
+    let (lo, hi) = core.range;
     let curve: Vec<[f64; 2]> = (0..=200)
         .map(|i| {
             let u = lo + (hi - lo) * i as f64 / 200.0;
-            [u, g.g(u)]
+            [u, core.g.g(u)]
         })
         .collect();
-    let t = knots.t.clone();
-    let mut p: Vec<f64> = t.iter().map(|&u| g.g(u)).collect();
-    let d = opts.fd_step * knots.h;
-    let mut m = knot_slopes(&g, &t, d, (x, psi, stress), opts)?;
-    if p.iter().chain(&m).any(|v| !v.is_finite()) {
-        return Err(FitError::BadOption(
-            "the MLS curve overflowed (Ψ too large for symexp)".into(),
-        ));
-    }
-
-    // step 3: quasi-convexify outward from i_min
-    let i_min = knots.minimum(opts.minimum, &p, lo, hi)?;
-    let pmin = opts.min_slope;
-    quasi_convexify(
-        &t,
-        &mut p,
-        &mut m,
-        i_min,
-        pmin,
-        opts.minimum == MinimumAt::Zero,
-    );
-
-    // steps 5 and 4: end slopes, Fritsch–Carlson
-    limit_slopes(&t, &p, &mut m, pmin);
-
-    // step 6: residual form
-    let (spline, offset) = residual_form(Hermite1D::new(t, p, m));
+    let spline = Hermite1D::new(core.t, core.p, core.m);
+    let (offset, xs, ys) = (core.offset, core.xs, core.ys);
 
     // report
     let mut err = super::RelError::default();
@@ -389,10 +494,10 @@ pub fn fit1d_with_stress(
     }
     let report = Fit1DReport {
         n_samples: xs.len(),
-        n_excluded,
+        n_excluded: core.n_excluded,
         rms_rel: err.rms_rel(),
         max_rel: err.max_rel(),
-        i_min,
+        i_min: core.i_min,
     };
     Ok(Fit1D {
         spline,

@@ -59,6 +59,12 @@ impl Mls1D {
     /// data); where the weighted quadratic system is numerically singular (far outside the samples) the local
     /// model drops to a line, then to a constant.
     pub fn eval(&self, u: f64) -> f64 {
+        self.eval_with(u, &self.y)
+    }
+
+    /// [`Mls1D::eval`] with the values `y` in place of the samples' (same abscissae, so the same weights and
+    /// the same local model): the MLS is linear in the values, Σᵢ ℓᵢ(u) yᵢ.
+    pub fn eval_with(&self, u: f64, y: &[f64]) -> f64 {
         let b = self.bandwidth;
         let d2min = self
             .x
@@ -68,7 +74,7 @@ impl Mls1D {
         // normal equations in the scaled coordinate d = (x − u)/b with basis 1, d, d²: moments Σ w dᵏ, Σ w dᵏ y
         let mut s = [0.0f64; 5];
         let mut r = [0.0f64; 3];
-        for (&x, &y) in self.x.iter().zip(&self.y) {
+        for (&x, &y) in self.x.iter().zip(y) {
             let d = (x - u) / b;
             let w = (-0.5 * (d * d - d2min)).exp();
             let mut dk = w;
@@ -95,7 +101,12 @@ impl Mls1D {
 
     /// The symmetrised MLS ½(MLS(u) + MLS(−u)) used for the shear strain s_a.
     pub fn eval_symmetric(&self, u: f64) -> f64 {
-        0.5 * (self.eval(u) + self.eval(-u))
+        self.eval_symmetric_with(u, &self.y)
+    }
+
+    /// [`Mls1D::eval_symmetric`] with the values `y` in place of the samples'.
+    pub fn eval_symmetric_with(&self, u: f64, y: &[f64]) -> f64 {
+        0.5 * (self.eval_with(u, y) + self.eval_with(-u, y))
     }
 }
 
@@ -178,10 +189,17 @@ impl Mls2D {
     /// the weighted design matrix (not the normal equations, whose squared condition number costs ~8 digits at the
     /// edges of the data); where R is numerically singular the local model drops to a plane, then to a constant.
     pub fn eval(&self, u: f64, v: f64) -> f64 {
+        self.eval_with(u, v, &[&self.f])[0]
+    }
+
+    /// [`Mls2D::eval`] for several value vectors `fs` at the samples' abscissae (linear in each: Σᵢ ℓᵢ(u, v)
+    /// fᵢ). The weights and the QR are formed once; the fallback to a plane or a constant is decided on the first
+    /// vector and used for all.
+    pub fn eval_with(&self, u: f64, v: f64, fs: &[&[f64]]) -> Vec<f64> {
         let [bu, bv] = self.bandwidth;
         let d2 = |i: usize| ((self.x[i] - u) / bu).powi(2) + ((self.y[i] - v) / bv).powi(2);
         let d2min = (0..self.x.len()).map(d2).fold(f64::INFINITY, f64::min);
-        let mut rows: Vec<([f64; 6], f64)> = Vec::new();
+        let mut rows: Vec<([f64; 6], usize, f64)> = Vec::new();
         for i in 0..self.x.len() {
             let (du, dv) = ((self.x[i] - u) / bu, (self.y[i] - v) / bv);
             let w = (-0.5 * (du * du + dv * dv - d2min)).exp();
@@ -191,7 +209,8 @@ impl Mls2D {
             let s = w.sqrt();
             rows.push((
                 [s, s * du, s * dv, s * du * du, s * du * dv, s * dv * dv],
-                s * self.f[i],
+                i,
+                s,
             ));
         }
         for n in [6usize, 3, 1] {
@@ -199,32 +218,58 @@ impl Mls2D {
                 continue;
             }
             let a = nalgebra::DMatrix::from_fn(rows.len(), n, |i, j| rows[i].0[j]);
-            let mut rhs = nalgebra::DVector::from_fn(rows.len(), |i, _| rows[i].1);
             let qr = a.qr();
             let r = qr.r();
             let rmax = (0..n).fold(0.0f64, |m, i| m.max(r[(i, i)].abs()));
             if (0..n).any(|i| r[(i, i)].abs() <= 1e-7 * rmax || !r[(i, i)].is_finite()) {
                 continue;
             }
-            qr.q_tr_mul(&mut rhs);
-            if let Some(c) = r.solve_upper_triangular(&rhs.rows(0, n).clone_owned()) {
-                if c[0].is_finite() {
-                    return c[0];
-                }
+            let solve = |f: &[f64]| {
+                let mut rhs =
+                    nalgebra::DVector::from_fn(rows.len(), |i, _| rows[i].2 * f[rows[i].1]);
+                qr.q_tr_mul(&mut rhs);
+                r.solve_upper_triangular(&rhs.rows(0, n).clone_owned())
+                    .map_or(f64::NAN, |c| c[0])
+            };
+            let first = solve(fs[0]);
+            if first.is_finite() {
+                let mut out = vec![first];
+                out.extend(fs[1..].iter().map(|f| solve(f)));
+                return out;
             }
         }
-        f64::NAN
+        vec![f64::NAN; fs.len()]
     }
 
     /// ½(MLS(u, v) + MLS(−u, v)) (`sym_u`) and/or the same in v: the symmetrisation for the shear strain s_a.
     pub fn eval_symmetric(&self, u: f64, v: f64, sym_u: bool, sym_v: bool) -> f64 {
+        self.eval_symmetric_with(u, v, sym_u, sym_v, &[&self.f])[0]
+    }
+
+    /// [`Mls2D::eval_symmetric`] for several value vectors ([`Mls2D::eval_with`]).
+    pub fn eval_symmetric_with(
+        &self,
+        u: f64,
+        v: f64,
+        sym_u: bool,
+        sym_v: bool,
+        fs: &[&[f64]],
+    ) -> Vec<f64> {
+        let e = |u: f64, v: f64| self.eval_with(u, v, fs);
+        let combine = |vals: &[Vec<f64>], w: f64| -> Vec<f64> {
+            (0..fs.len())
+                .map(|k| match vals {
+                    [a, b] => w * (a[k] + b[k]),
+                    [a, b, c, d] => w * (a[k] + b[k] + c[k] + d[k]),
+                    _ => vals[0][k],
+                })
+                .collect()
+        };
         match (sym_u, sym_v) {
-            (false, false) => self.eval(u, v),
-            (true, false) => 0.5 * (self.eval(u, v) + self.eval(-u, v)),
-            (false, true) => 0.5 * (self.eval(u, v) + self.eval(u, -v)),
-            (true, true) => {
-                0.25 * (self.eval(u, v) + self.eval(-u, v) + self.eval(u, -v) + self.eval(-u, -v))
-            }
+            (false, false) => e(u, v),
+            (true, false) => combine(&[e(u, v), e(-u, v)], 0.5),
+            (false, true) => combine(&[e(u, v), e(u, -v)], 0.5),
+            (true, true) => combine(&[e(u, v), e(-u, v), e(u, -v), e(-u, -v)], 0.25),
         }
     }
 }

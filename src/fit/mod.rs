@@ -9,7 +9,9 @@ pub mod mls;
 pub mod model;
 pub mod plot;
 pub mod preset;
+pub mod scalar;
 pub mod symlog;
+pub mod tangent;
 
 pub use fit1d::{
     fit1d, fit1d_with_stress, Fit1D, Fit1DOptions, Fit1DReport, MinimumAt, SlopeSource,
@@ -22,6 +24,8 @@ pub use model::{
 };
 pub use plot::PlotError;
 pub use preset::FitPreset;
+pub use scalar::{FitScalar, Kink, KinkReport, KinkRule};
+pub use tangent::{fit_material_tangent, fit_material_tangents, RecordTangent};
 
 /// Why a fit could not be made. Bad input is reported, never a panic.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -44,6 +48,10 @@ pub enum FitError {
     /// the fitted model came out with a non-finite number (named), so no material is written
     #[error("the fit did not converge: {0} is not finite")]
     NotFinite(String),
+    /// a tangent pass of the fit ([`tangent`]) whose real parts are not the fit's coefficients (it would not
+    /// follow the fit's branch): the first coefficient that differs
+    #[error("the tangent pass left the fit's branch: {0}")]
+    Branch(String),
     /// a sample record that cannot be fitted: its id, the field and what is wrong
     #[error("sample {id}: {field}: {message}")]
     BadRecord {

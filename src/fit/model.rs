@@ -330,14 +330,14 @@ pub fn model_error<'a>(
 
 /// The plan's records by sample index (later duplicates replace earlier ones; indices beyond the plan are
 /// dropped).
-struct ByIndex<'a> {
+pub(super) struct ByIndex<'a> {
     records: Vec<Option<&'a Record>>,
 }
 
 impl<'a> ByIndex<'a> {
     /// Index `records` by their position in `plan`; a record whose id does not carry the plan's `hash` is an
     /// error.
-    fn new(plan: &Plan, records: &'a [Record], hash: &str) -> Result<Self, FitError> {
+    pub(super) fn new(plan: &Plan, records: &'a [Record], hash: &str) -> Result<Self, FitError> {
         let n = plan.len();
         let mut by_index: Vec<Option<&Record>> = vec![None; n];
         for r in records {
@@ -355,19 +355,19 @@ impl<'a> ByIndex<'a> {
     }
 
     /// The records present, in plan order.
-    fn present(&self) -> Vec<&'a Record> {
+    pub(super) fn present(&self) -> Vec<&'a Record> {
         self.records.iter().flatten().copied().collect()
     }
 
     /// Ψ̄ of sample `i` (NaN when missing or failed).
-    fn psi(&self, i: usize) -> f64 {
+    pub(super) fn psi(&self, i: usize) -> f64 {
         self.records[i]
             .and_then(Record::converged_psi)
             .unwrap_or(f64::NAN)
     }
 
     /// The stress dΨ̄/dX of sample `i` along strain `k` in normalised units X = z_k/σ (NaN when missing).
-    fn stress(&self, i: usize, k: usize, sigma: f64) -> f64 {
+    pub(super) fn stress(&self, i: usize, k: usize, sigma: f64) -> f64 {
         self.records[i]
             .filter(|r| r.converged_psi().is_some())
             .and_then(|r| r.stress)
@@ -382,7 +382,7 @@ impl<'a> ByIndex<'a> {
 }
 
 /// Strain scales σ_k = max |z_k| over the plan's samples (1 for a strain the plan never varies).
-fn strain_scales(samples: &[Sample]) -> [f64; 5] {
+pub(super) fn strain_scales(samples: &[Sample]) -> [f64; 5] {
     let mut sigma = [0.0f64; 5];
     for s in samples {
         for k in 0..5 {
@@ -398,7 +398,7 @@ fn strain_scales(samples: &[Sample]) -> [f64; 5] {
 }
 
 /// FIT1D's options for strain `k`: symmetrised for s_a, minimum at 0 in-plane and at argmin p for bending.
-fn options_1d(k: usize, opts: &FitOptions) -> Fit1DOptions {
+pub(super) fn options_1d(k: usize, opts: &FitOptions) -> Fit1DOptions {
     Fit1DOptions {
         n_knots: opts.n_knots_1d,
         extent: opts.extent_1d,
@@ -416,6 +416,29 @@ fn options_1d(k: usize, opts: &FitOptions) -> Fit1DOptions {
     }
 }
 
+/// The plan indices of the samples the 1D term of strain `k` is fitted to: every `thin_1d`-th of its range.
+pub(super) fn term_indices_1d(plan: &Plan, k: usize, opts: &FitOptions) -> Vec<usize> {
+    let range = plan.range_1d(k);
+    range
+        .clone()
+        .filter(|i| (i - range.start).is_multiple_of(opts.thin_1d.max(1)))
+        .collect()
+}
+
+/// The name of the 1D term of strain `k` in errors and kink reports.
+pub(super) fn term_name_1d(k: usize) -> String {
+    format!("1D term {} ({})", k, StrainComponent::NAMES[k])
+}
+
+/// The name of the 2D term (k0, k1) in errors and kink reports.
+pub(super) fn term_name_2d(k0: usize, k1: usize) -> String {
+    format!(
+        "2D term ({}, {})",
+        StrainComponent::NAMES[k0],
+        StrainComponent::NAMES[k1]
+    )
+}
+
 /// The 1D terms f_k: FIT1D on every `thin_1d`-th sample of each strain's 1D range.
 fn fit_terms1d(
     plan: &Plan,
@@ -426,11 +449,7 @@ fn fit_terms1d(
 ) -> Result<Vec<(usize, Fit1D, TermData)>, FitError> {
     let mut fits1d = Vec::new();
     for k in 0..5 {
-        let range = plan.range_1d(k);
-        let idx: Vec<usize> = range
-            .clone()
-            .filter(|i| (i - range.start).is_multiple_of(opts.thin_1d.max(1)))
-            .collect();
+        let idx = term_indices_1d(plan, k, opts);
         let x: Vec<f64> = idx.iter().map(|&i| samples[i].z[k] / sigma[k]).collect();
         let psi: Vec<f64> = idx.iter().map(|&i| by_index.psi(i)).collect();
         let stress: Vec<f64> = idx
@@ -439,7 +458,7 @@ fn fit_terms1d(
             .collect();
         let o = options_1d(k, opts);
         let fit = fit1d_with_stress(&x, &psi, Some(&stress), &o).map_err(|e| FitError::Term {
-            term: format!("1D term {} ({})", k, StrainComponent::NAMES[k]),
+            term: term_name_1d(k),
             source: Box::new(e),
         })?;
         fits1d.push((k, fit, TermData { x, y: vec![], psi }));
@@ -450,11 +469,11 @@ fn fit_terms1d(
 /// The constant f₀ and the strain of the sample it was taken from: Ψ̄ of the converged sample nearest z = 0 in
 /// normalised units, among the s_a range's samples when any of them converged (Ψ̄ is even in s_a, so its error is
 /// second order), else among all.
-fn constant_term(
+pub(super) fn constant_term(
     plan: &Plan,
     present: &[&Record],
     sigma: [f64; 5],
-) -> Result<(f64, [f64; 5]), FitError> {
+) -> Result<(f64, [f64; 5], usize), FitError> {
     let sa_range = plan.range_1d(1);
     let on_sa = present
         .iter()
@@ -471,13 +490,17 @@ fn constant_term(
             usable: 0,
             needed: 1,
         })?;
-    Ok((nearest.1.converged_psi().unwrap_or(0.0), nearest.1.z))
+    Ok((
+        nearest.1.converged_psi().unwrap_or(0.0),
+        nearest.1.z,
+        nearest.1.index,
+    ))
 }
 
 /// FIT2D's options for the pair (k0, k1), k0 < k1: (s_x, s_y) neither quasi-convexified nor zero-compressed, a
 /// stretch axis zero-compressed, an s_a axis symmetrised, a bending axis with its minimum at argmin and the
 /// bending pairs' knot count and extent.
-fn options_2d(k0: usize, k1: usize, opts: &FitOptions) -> Fit2DOptions {
+pub(super) fn options_2d(k0: usize, k1: usize, opts: &FitOptions) -> Fit2DOptions {
     let stretch = |k: usize| k == 0 || k == 2;
     let bending = k1 >= 3;
     Fit2DOptions {
@@ -529,11 +552,7 @@ fn fit_terms2d(
         let psi: Vec<f64> = idx.iter().map(|&i| by_index.psi(i)).collect();
         let o = options_2d(k0, k1, opts);
         let fit = fit2d(&x, &y, &psi, &o).map_err(|e| FitError::Term {
-            term: format!(
-                "2D term ({}, {})",
-                StrainComponent::NAMES[k0],
-                StrainComponent::NAMES[k1]
-            ),
+            term: term_name_2d(k0, k1),
             source: Box::new(e),
         })?;
         fits2d.push((k0, k1, fit, TermData { x, y, psi }));
@@ -704,7 +723,7 @@ pub fn fit_material(
     let sigma = strain_scales(&samples);
 
     let fits1d = fit_terms1d(plan, &samples, &by_index, sigma, opts)?;
-    let (constant, constant_at) = constant_term(plan, &present, sigma)?;
+    let (constant, constant_at, _) = constant_term(plan, &present, sigma)?;
     let spread = fits1d[..3]
         .iter()
         .map(|(_, f, _)| (f.offset - constant).abs())

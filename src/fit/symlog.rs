@@ -2,6 +2,8 @@
 //! symlog(v) = sgn(v) ln(1 + |v|/ε) and its inverse symexp(w) = sgn(w) ε (e^|w| − 1). It compresses the range of
 //! energies that grow by orders of magnitude over a strain range while staying linear (slope 1/ε) near 0.
 
+use super::scalar::{FitScalar, KinkRule, Kinks};
+
 /// symlog(v) = sgn(v) ln(1 + |v|/ε), ε > 0. symlog(±0) = ±0; NaN stays NaN.
 #[inline]
 pub fn symlog(v: f64, eps: f64) -> f64 {
@@ -17,13 +19,52 @@ pub fn symexp(w: f64, eps: f64) -> f64 {
 /// Step 1's transform of the sample values: ε = `eps_rel` · max|Ψ| (1 when all Ψ are 0) and symlog(Ψ, ε) of
 /// each. Returns (ε, the transformed values).
 pub fn symlog_samples(psi: &[f64], eps_rel: f64) -> (f64, Vec<f64>) {
-    let psi_max = psi.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let eps = if psi_max > 0.0 {
-        eps_rel * psi_max
+    symlog_samples_t(psi, eps_rel, &mut Kinks::off(), |_| String::new())
+}
+
+/// [`symlog`] over a [`FitScalar`]: sgn(v) ln(1 + |v|/ε), the sign taken from the real part (the function is C¹
+/// at v = 0, slope 1/ε from both sides).
+pub fn symlog_t<T: FitScalar>(v: T, eps: T) -> T {
+    v.copysign_of(1.0).quot(eps).ln_1p().copysign_of(v.value())
+}
+
+/// [`symexp`] over a [`FitScalar`]: sgn(w) ε (e^|w| − 1).
+pub fn symexp_t<T: FitScalar>(w: T, eps: T) -> T {
+    (eps * w.copysign_of(1.0).exp_m1()).copysign_of(w.value())
+}
+
+/// [`symlog_samples`] over a [`FitScalar`]: ε = `eps_rel` · |Ψ_a| with a = argmax |Ψᵢ| (on the real parts), so ε
+/// carries the tangent of that sample; another sample within a relative 1e-9 of the largest |Ψ| is a kink
+/// ([`KinkRule::SymlogScale`], the site named by `site(i)`).
+pub(crate) fn symlog_samples_t<T: FitScalar>(
+    psi: &[T],
+    eps_rel: f64,
+    kinks: &mut Kinks,
+    site: impl Fn(usize) -> String,
+) -> (T, Vec<T>) {
+    let zero = T::from(0.0);
+    let (mut psi_max, mut at) = (zero, None);
+    for (i, &v) in psi.iter().enumerate() {
+        let a = v.copysign_of(1.0);
+        let m = psi_max.max_of(a);
+        if m.value() != psi_max.value() {
+            at = Some(i);
+        }
+        psi_max = m;
+    }
+    if let Some(a) = at {
+        for (i, &v) in psi.iter().enumerate().filter(|&(i, _)| i != a) {
+            kinks.tie(v.copysign_of(1.0), psi_max, KinkRule::SymlogScale, || {
+                format!("{} and {}", site(a), site(i))
+            });
+        }
+    }
+    let eps = if psi_max.value() > 0.0 {
+        psi_max * eps_rel
     } else {
-        1.0
+        T::from(1.0)
     };
-    (eps, psi.iter().map(|&v| symlog(v, eps)).collect())
+    (eps, psi.iter().map(|&v| symlog_t(v, eps)).collect())
 }
 
 #[cfg(test)]

@@ -25,25 +25,29 @@
 //! samples couple, and never lowers it below f₀.
 
 use super::{outward, Grid, PatchRounds};
+use crate::fit::scalar::{FitScalar, KinkRule, Kinks};
 
 /// The compressed block of a residual grid, as a grid of its own with the stretch axis first (u) and the zero
 /// lines at its last column (u = 0) and at row `j0`.
-struct Block {
-    grid: Grid,
+struct Block<T> {
+    grid: Grid<T>,
     j0: usize,
+    /// whether the block is the transposed grid's (for the kink report's knot names)
+    transposed: bool,
 }
 
-impl Grid {
+impl<T: FitScalar> Grid<T> {
     /// The transposed grid (u and v exchanged).
-    fn transposed(&self) -> Grid {
+    fn transposed(&self) -> Grid<T> {
         let (nu, nv) = (self.tu.len(), self.tv.len());
+        let zero = T::from(0.0);
         let mut t = Grid {
             tu: self.tv.clone(),
             tv: self.tu.clone(),
-            p: vec![0.0; nu * nv],
-            mu: vec![0.0; nu * nv],
-            mv: vec![0.0; nu * nv],
-            muv: vec![0.0; nu * nv],
+            p: vec![zero; nu * nv],
+            mu: vec![zero; nu * nv],
+            mv: vec![zero; nu * nv],
+            muv: vec![zero; nu * nv],
         };
         for j in 0..nv {
             for i in 0..nu {
@@ -58,7 +62,7 @@ impl Grid {
     }
 
     /// Columns `0..=i0` of the grid.
-    fn left_block(&self, i0: usize) -> Grid {
+    fn left_block(&self, i0: usize) -> Grid<T> {
         let nv = self.tv.len();
         let mut b = Grid {
             tu: self.tu[..=i0].to_vec(),
@@ -81,7 +85,7 @@ impl Grid {
     }
 
     /// Write `b` (columns `0..=i0`) back.
-    fn put_left_block(&mut self, b: &Grid) {
+    fn put_left_block(&mut self, b: &Grid<T>) {
         for j in 0..b.tv.len() {
             for i in 0..b.tu.len() {
                 let (k, kb) = (self.at(i, j), b.at(i, j));
@@ -94,32 +98,44 @@ impl Grid {
     }
 }
 
-impl Block {
+impl<T: FitScalar> Block<T> {
     /// Steps 1–3 on the block: zero lines, values raised outward, outward slope signs, zero boundary slopes.
-    fn raise(&mut self) {
-        let g = &mut self.grid;
-        let (nu, nv, j0) = (g.tu.len(), g.tv.len(), self.j0);
+    fn raise(&mut self, kinks: &mut Kinks) {
+        let (nu, nv, j0) = (self.grid.tu.len(), self.grid.tv.len(), self.j0);
         let i0 = nu - 1;
+        let zero = T::from(0.0);
+        let transposed = self.transposed;
+        let g = &mut self.grid;
         for j in 0..nv {
             let k = g.at(i0, j);
-            (g.p[k], g.mu[k], g.mv[k], g.muv[k]) = (0.0, 0.0, 0.0, 0.0);
+            (g.p[k], g.mu[k], g.mv[k], g.muv[k]) = (zero, zero, zero, zero);
         }
         for i in 0..nu {
             let k = g.at(i, j0);
-            (g.p[k], g.mu[k], g.mv[k], g.muv[k]) = (0.0, 0.0, 0.0, 0.0);
+            (g.p[k], g.mu[k], g.mv[k], g.muv[k]) = (zero, zero, zero, zero);
         }
+        let (cv, cs) = (KinkRule::CompressionValue, KinkRule::CompressionSlope);
         for &j in &outward(nv, j0) {
             for i in (0..i0).rev() {
+                // the knot's name in the term's grid
+                let site = || {
+                    if transposed {
+                        format!("knot ({j}, {i})")
+                    } else {
+                        format!("knot ({i}, {j})")
+                    }
+                };
                 let k = g.at(i, j);
-                let mut v = g.p[k].max(0.0).max(g.p[g.at(i + 1, j)]);
-                g.mu[k] = g.mu[k].min(0.0);
+                let v = kinks.max(g.p[k], zero, cv, site);
+                let mut v = kinks.max(v, g.p[g.at(i + 1, j)], cv, site);
+                g.mu[k] = kinks.min(g.mu[k], zero, cs, site);
                 if j != j0 {
                     let jj = if j > j0 { j - 1 } else { j + 1 };
-                    v = v.max(g.p[g.at(i, jj)]);
+                    v = kinks.max(v, g.p[g.at(i, jj)], cv, site);
                     g.mv[k] = if j > j0 {
-                        g.mv[k].max(0.0)
+                        kinks.max(g.mv[k], zero, cs, site)
                     } else {
-                        g.mv[k].min(0.0)
+                        kinks.min(g.mv[k], zero, cs, site)
                     };
                 }
                 g.p[k] = v;
@@ -136,8 +152,8 @@ impl Block {
     fn flat_knots_untwisted(&mut self) {
         let g = &mut self.grid;
         for k in 0..g.p.len() {
-            if g.p[k] == 0.0 && g.mu[k] == 0.0 && g.mv[k] == 0.0 {
-                g.muv[k] = 0.0;
+            if g.p[k].value() == 0.0 && g.mu[k].value() == 0.0 && g.mv[k].value() == 0.0 {
+                g.muv[k] = T::from(0.0);
             }
         }
     }
@@ -145,7 +161,10 @@ impl Block {
     /// The patches failing the outward certificate: along u towards −u everywhere, along v away from row j0.
     fn failing(&self) -> Vec<((usize, usize), bool, bool)> {
         let g = &self.grid;
-        let scale = g.p.iter().fold(0.0f64, |m, v| m.max(v.abs())).max(1e-300);
+        let scale =
+            g.p.iter()
+                .fold(0.0f64, |m, v| m.max(v.value().abs()))
+                .max(1e-300);
         let tol = 1e-10 * scale;
         let mut out = Vec::new();
         for cj in 0..g.tv.len() - 1 {
@@ -180,7 +199,7 @@ impl Block {
                     if !seen.insert((k, fu, fv)) {
                         continue;
                     }
-                    self.grid.muv[k] = 0.0;
+                    self.grid.muv[k] = T::from(0.0);
                     if fu {
                         self.grid.mv[k] *= 0.5;
                     }
@@ -207,7 +226,7 @@ impl Block {
     }
 }
 
-impl Grid {
+impl<T: FitScalar> Grid<T> {
     /// Step 7′ on a residual grid about the knots u = 0 (`i0`) and v = 0 (`j0`): the compressed block of the
     /// stretch axis (`stretch[0]`: u; else `stretch[1]`: v) made a non-negative excess monotone outward from
     /// the zero lines; the rest as step 7 leaves it (zero on the knot line 0 of the stretch axis). A pair with
@@ -217,6 +236,7 @@ impl Grid {
         stretch: [bool; 2],
         i0: usize,
         j0: usize,
+        kinks: &mut Kinks,
     ) -> PatchRounds {
         let transpose = match stretch {
             [true, false] => false,
@@ -234,11 +254,12 @@ impl Grid {
         let mut block = Block {
             grid: work.left_block(c0),
             j0: r0,
+            transposed: transpose,
         };
-        block.raise();
+        block.raise(kinks);
         // step 4, grid lines: Fritsch–Carlson along every row and column, no knot exempt (the zero lines'
         // slopes are 0)
-        block.grid.limit_lines(None, None);
+        block.grid.limit_lines(None, None, kinks);
         block.flat_knots_untwisted();
         let rounds = block.monotone_patches();
         work.put_left_block(&block.grid);

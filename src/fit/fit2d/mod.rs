@@ -50,7 +50,8 @@
 
 use super::fit1d::MinimumAt;
 use super::mls::{Mls2D, DEFAULT_BANDWIDTH_FACTOR};
-use super::symlog::{symexp, symlog_samples};
+use super::scalar::{FitScalar, KinkRule, Kinks};
+use super::symlog::{symexp_t, symlog_samples_t};
 use super::FitError;
 use crate::material::Hermite2D;
 
@@ -176,19 +177,46 @@ fn check_options(o: &Fit2DOptions) -> Result<(), FitError> {
 }
 
 /// Fritsch–Carlson limits along one grid line (step 5): `p`, `m` are the values and slopes at `t`; `min` is the
-/// minimum knot whose slope keeps its sign.
-fn limit_line(t: &[f64], p: &[f64], m: &mut [f64], min: Option<usize>) {
+/// minimum knot whose slope keeps its sign. The decisions are taken on the real parts; `site(i)` names knot `i`
+/// of the line for the kink report.
+fn limit_line<T: FitScalar>(
+    t: &[f64],
+    p: &[T],
+    m: &mut [T],
+    min: Option<usize>,
+    kinks: &mut Kinks,
+    site: &dyn Fn(usize) -> String,
+) {
+    let zero = T::from(0.0);
     for c in 0..t.len() - 1 {
         let secant = (p[c + 1] - p[c]) / (t[c + 1] - t[c]);
+        let cap = secant.copysign_of(1.0) * 3.0;
         for i in [c, c + 1] {
+            let (mi, s) = (m[i].value(), secant.value());
+            let agrees = mi * s > 0.0;
+            // where the secant is 0 the sign test switches between keeping the slope (or its cap) and 0
+            if min != Some(i) || mi.abs() > cap.value() {
+                kinks.tie(p[c + 1], p[c], KinkRule::FritschCarlsonSign, || site(i));
+            }
+            if min != Some(i) {
+                kinks.tie(m[i], zero, KinkRule::FritschCarlsonSign, || site(i));
+            }
+            if agrees {
+                kinks.tie(
+                    m[i].copysign_of(1.0),
+                    cap,
+                    KinkRule::FritschCarlsonCap,
+                    || site(i),
+                );
+            }
             if min == Some(i) {
-                if m[i] * secant > 0.0 && m[i].abs() > 3.0 * secant.abs() {
-                    m[i] = (3.0 * secant.abs()).copysign(m[i]);
+                if agrees && mi.abs() > (3.0 * s.abs()) {
+                    m[i] = cap.copysign_of(mi);
                 }
-            } else if m[i] * secant <= 0.0 {
-                m[i] = 0.0;
-            } else if m[i].abs() > 3.0 * secant.abs() {
-                m[i] = (3.0 * secant.abs()).copysign(m[i]);
+            } else if mi * s <= 0.0 {
+                m[i] = zero;
+            } else if mi.abs() > (3.0 * s.abs()) {
+                m[i] = cap.copysign_of(mi);
             }
         }
     }
@@ -203,28 +231,30 @@ struct Failing {
 
 /// Grid data of a bicubic Hermite spline with u inner: index j·nu + i.
 #[derive(Clone)]
-struct Grid {
+pub(crate) struct Grid<T = f64> {
     tu: Vec<f64>,
     tv: Vec<f64>,
-    p: Vec<f64>,
-    mu: Vec<f64>,
-    mv: Vec<f64>,
-    muv: Vec<f64>,
+    pub(crate) p: Vec<T>,
+    pub(crate) mu: Vec<T>,
+    pub(crate) mv: Vec<T>,
+    pub(crate) muv: Vec<T>,
 }
 
-impl Grid {
+impl<T: FitScalar> Grid<T> {
     fn at(&self, i: usize, j: usize) -> usize {
         j * self.tu.len() + i
     }
 
+    /// The spline of the real parts.
     fn spline(&self) -> Hermite2D {
+        let re = |a: &[T]| a.iter().map(|v| v.value()).collect::<Vec<f64>>();
         Hermite2D::new(
             self.tu.clone(),
             self.tv.clone(),
-            self.p.clone(),
-            self.mu.clone(),
-            self.mv.clone(),
-            self.muv.clone(),
+            re(&self.p),
+            re(&self.mu),
+            re(&self.mv),
+            re(&self.muv),
         )
     }
 
@@ -248,10 +278,10 @@ impl Grid {
             for (l, gkl) in row.iter_mut().enumerate() {
                 let idx = self.at(ci + k % 2, cj + l % 2);
                 *gkl = match (k >= 2, l >= 2) {
-                    (false, false) => self.p[idx],
-                    (true, false) => hu * self.mu[idx],
-                    (false, true) => hv * self.mv[idx],
-                    (true, true) => hu * hv * self.muv[idx],
+                    (false, false) => self.p[idx].value(),
+                    (true, false) => hu * self.mu[idx].value(),
+                    (false, true) => hv * self.mv[idx].value(),
+                    (true, true) => hu * hv * self.muv[idx].value(),
                 };
             }
         }
@@ -276,7 +306,7 @@ impl Grid {
         let scale = self
             .p
             .iter()
-            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .fold(0.0f64, |m, v| m.max(v.value().abs()))
             .max(1e-300);
         // on ∂f/∂s = h_u ∂f/∂u (∂f/∂t = h_v ∂f/∂v): a drop of at most 1e-10 of the largest value across a patch
         let tol = 1e-10 * scale;
@@ -408,37 +438,49 @@ struct PatchRounds {
     nonmonotone: usize,
 }
 
-/// Step 1: g(u, v) = symexp(MLS(u, v | X, Y, symlog Ψ)), symmetrised in the axes that are s_a.
-struct Smoothed {
+/// Step 1: g(u, v) = symexp(MLS(u, v | X, Y, symlog Ψ)), symmetrised in the axes that are s_a. The MLS is linear
+/// in the transformed values, so it is applied to each part of them (one QR per point).
+struct Smoothed<T> {
     mls: Mls2D,
-    eps: f64,
+    logs: Vec<Vec<f64>>,
+    eps: T,
     symmetric: [bool; 2],
 }
 
-impl Smoothed {
-    fn new(xs: &[f64], ys: &[f64], fs: &[f64], opts: &Fit2DOptions) -> Result<Self, FitError> {
-        let (eps, logs) = symlog_samples(fs, opts.eps_rel);
-        let mls = Mls2D::new(xs, ys, &logs, opts.bandwidth_factor)?;
+impl<T: FitScalar> Smoothed<T> {
+    fn new(
+        (xs, ys, fs): (&[f64], &[f64], &[T]),
+        opts: &Fit2DOptions,
+        kinks: &mut Kinks,
+    ) -> Result<Self, FitError> {
+        let (eps, logs) = symlog_samples_t(fs, opts.eps_rel, kinks, |i| {
+            format!("sample at ({}, {})", xs[i], ys[i])
+        });
+        let re: Vec<f64> = logs.iter().map(|v| v.value()).collect();
+        let mls = Mls2D::new(xs, ys, &re, opts.bandwidth_factor)?;
         Ok(Smoothed {
             mls,
+            logs: T::parts(&logs),
             eps,
             symmetric: opts.symmetric,
         })
     }
 
-    fn g(&self, u: f64, v: f64) -> f64 {
+    fn g(&self, u: f64, v: f64) -> T {
         let [su, sv] = self.symmetric;
-        symexp(self.mls.eval_symmetric(u, v, su, sv), self.eps)
+        let fs: Vec<&[f64]> = self.logs.iter().map(|y| y.as_slice()).collect();
+        let w = T::from_parts(&self.mls.eval_symmetric_with(u, v, su, sv, &fs));
+        symexp_t(w, self.eps)
     }
 }
 
 /// The samples where x, y and Ψ are all finite, in their order.
-fn usable_samples(x: &[f64], y: &[f64], psi: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+fn usable_samples<T: FitScalar>(x: &[f64], y: &[f64], psi: &[T]) -> (Vec<f64>, Vec<f64>, Vec<T>) {
     let mut xs = Vec::new();
     let mut ys = Vec::new();
     let mut fs = Vec::new();
     for i in 0..psi.len() {
-        if x[i].is_finite() && y[i].is_finite() && psi[i].is_finite() {
+        if x[i].is_finite() && y[i].is_finite() && psi[i].value().is_finite() {
             xs.push(x[i]);
             ys.push(y[i]);
             fs.push(psi[i]);
@@ -456,11 +498,16 @@ fn outward(n: usize, c: usize) -> Vec<usize> {
     o
 }
 
-impl Grid {
+impl<T: FitScalar> Grid<T> {
     /// Step 2: the knots of both axes over the samples' ranges, p = g at the knots and pˣ, pʸ, pˣʸ by central
     /// differences of g (step `fd_step` × the smallest knot spacing of the axis). An error when g is not finite
     /// at a knot.
-    fn sample(g: &Smoothed, xs: &[f64], ys: &[f64], opts: &Fit2DOptions) -> Result<Grid, FitError> {
+    fn sample(
+        g: &Smoothed<T>,
+        xs: &[f64],
+        ys: &[f64],
+        opts: &Fit2DOptions,
+    ) -> Result<Grid<T>, FitError> {
         let range = |d: &[f64]| {
             d.iter()
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
@@ -479,11 +526,12 @@ impl Grid {
         };
         let du = opts.fd_step * min_gap(&tu);
         let dv = opts.fd_step * min_gap(&tv);
+        let zero = T::from(0.0);
         let mut grid = Grid {
-            p: vec![0.0; nu * nv],
-            mu: vec![0.0; nu * nv],
-            mv: vec![0.0; nu * nv],
-            muv: vec![0.0; nu * nv],
+            p: vec![zero; nu * nv],
+            mu: vec![zero; nu * nv],
+            mv: vec![zero; nu * nv],
+            muv: vec![zero; nu * nv],
             tu,
             tv,
         };
@@ -502,7 +550,7 @@ impl Grid {
         }
         if [&grid.p, &grid.mu, &grid.mv, &grid.muv]
             .iter()
-            .any(|a| a.iter().any(|v| !v.is_finite()))
+            .any(|a| a.iter().any(|v| !v.value().is_finite()))
         {
             return Err(FitError::BadOption(
                 "the MLS surface is not finite at the knots (Ψ too large for symexp, or too few samples near a knot)"
@@ -514,19 +562,22 @@ impl Grid {
 
     /// Step 3's minimum knot: i_min = the knot u = 0; j_min = the knot v = 0 ([`MinimumAt::Zero`]) or argmin_j
     /// p(0, v_j) ([`MinimumAt::Argmin`]).
-    fn minimum(&self, rule: MinimumAt) -> Minimum {
+    fn minimum(&self, rule: MinimumAt, kinks: &mut Kinks) -> Minimum {
         let nv = self.tv.len();
         let i_min = self.tu.iter().position(|&t| t == 0.0).unwrap_or(0);
         let j0 = self.tv.iter().position(|&t| t == 0.0).unwrap_or(0);
         let j_min = match rule {
             MinimumAt::Zero => j0,
-            MinimumAt::Argmin => (0..nv).fold(0, |b, j| {
-                if self.p[self.at(i_min, j)] < self.p[self.at(i_min, b)] {
-                    j
-                } else {
-                    b
+            MinimumAt::Argmin => {
+                let pj = |j: usize| self.p[self.at(i_min, j)];
+                let b = (0..nv).fold(0, |b, j| if pj(j).value() < pj(b).value() { j } else { b });
+                for j in (0..nv).filter(|&j| j != b) {
+                    kinks.tie(pj(j), pj(b), KinkRule::MinimumKnot, || {
+                        format!("knots ({i_min}, {b}) and ({i_min}, {j})")
+                    });
                 }
-            }),
+                b
+            }
         };
         Minimum {
             i: i_min,
@@ -538,29 +589,34 @@ impl Grid {
     /// Step 3: rows outward from j_min, each row outward from i_min, every value raised to ≥ its inner neighbours
     /// along the row and the column plus their distance × pˣ_min; slopes pointing away from the minimum are at
     /// least pˣ_min.
-    fn quasi_convexify(&mut self, min: &Minimum, pmin: f64) {
+    fn quasi_convexify(&mut self, min: &Minimum, pmin: f64, kinks: &mut Kinks) {
         let (i_min, j_min) = (min.i, min.j);
         let (nu, nv) = (self.tu.len(), self.tv.len());
+        let bound = T::from(pmin);
+        let (qv, qs) = (KinkRule::QuasiConvexValue, KinkRule::QuasiConvexSlope);
         for &j in &outward(nv, j_min) {
             for &i in &outward(nu, i_min) {
                 let k = self.at(i, j);
+                let site = || format!("knot ({i}, {j})");
                 let mut v = self.p[k];
                 if i != i_min {
                     let ii = if i > i_min { i - 1 } else { i + 1 };
-                    v = v.max(self.p[self.at(ii, j)] + (self.tu[i] - self.tu[ii]).abs() * pmin);
+                    let w = self.p[self.at(ii, j)] + (self.tu[i] - self.tu[ii]).abs() * pmin;
+                    v = kinks.max(v, w, qv, site);
                     self.mu[k] = if i > i_min {
-                        self.mu[k].max(pmin)
+                        kinks.max(self.mu[k], bound, qs, site)
                     } else {
-                        self.mu[k].min(-pmin)
+                        kinks.min(self.mu[k], -bound, qs, site)
                     };
                 }
                 if j != j_min {
                     let jj = if j > j_min { j - 1 } else { j + 1 };
-                    v = v.max(self.p[self.at(i, jj)] + (self.tv[j] - self.tv[jj]).abs() * pmin);
+                    let w = self.p[self.at(i, jj)] + (self.tv[j] - self.tv[jj]).abs() * pmin;
+                    v = kinks.max(v, w, qv, site);
                     self.mv[k] = if j > j_min {
-                        self.mv[k].max(pmin)
+                        kinks.max(self.mv[k], bound, qs, site)
                     } else {
-                        self.mv[k].min(-pmin)
+                        kinks.min(self.mv[k], -bound, qs, site)
                     };
                 }
                 self.p[k] = v;
@@ -570,23 +626,24 @@ impl Grid {
 
     /// Step 4: boundary pˣ (first/last column) clamped to ≤ −pˣ_min / ≥ pˣ_min, boundary pʸ likewise, pˣʸ = 0 on
     /// the boundary.
-    fn clamp_boundary(&mut self, pmin: f64) {
+    fn clamp_boundary(&mut self, pmin: f64, kinks: &mut Kinks) {
         let (nu, nv) = (self.tu.len(), self.tv.len());
+        let (bound, e) = (T::from(pmin), KinkRule::EndSlope);
         for j in 0..nv {
             let (a, b) = (self.at(0, j), self.at(nu - 1, j));
-            self.mu[a] = self.mu[a].min(-pmin);
-            self.mu[b] = self.mu[b].max(pmin);
+            self.mu[a] = kinks.min(self.mu[a], -bound, e, || format!("knot (0, {j})"));
+            self.mu[b] = kinks.max(self.mu[b], bound, e, || format!("knot ({}, {j})", nu - 1));
         }
         for i in 0..nu {
             let (a, b) = (self.at(i, 0), self.at(i, nv - 1));
-            self.mv[a] = self.mv[a].min(-pmin);
-            self.mv[b] = self.mv[b].max(pmin);
+            self.mv[a] = kinks.min(self.mv[a], -bound, e, || format!("knot ({i}, 0)"));
+            self.mv[b] = kinks.max(self.mv[b], bound, e, || format!("knot ({i}, {})", nv - 1));
         }
         for j in 0..nv {
             for i in 0..nu {
                 if i == 0 || j == 0 || i == nu - 1 || j == nv - 1 {
                     let k = self.at(i, j);
-                    self.muv[k] = 0.0;
+                    self.muv[k] = T::from(0.0);
                 }
             }
         }
@@ -594,22 +651,26 @@ impl Grid {
 
     /// Step 5, grid lines: Fritsch–Carlson limits ([`limit_line`]) on pˣ along every row and on pʸ along every
     /// column; `mi`, `mj` are the minimum knots whose slopes keep their sign.
-    fn limit_lines(&mut self, mi: Option<usize>, mj: Option<usize>) {
+    fn limit_lines(&mut self, mi: Option<usize>, mj: Option<usize>, kinks: &mut Kinks) {
         let (nu, nv) = (self.tu.len(), self.tv.len());
         for j in 0..nv {
             let ks: Vec<usize> = (0..nu).map(|i| self.at(i, j)).collect();
-            let p: Vec<f64> = ks.iter().map(|&k| self.p[k]).collect();
-            let mut m: Vec<f64> = ks.iter().map(|&k| self.mu[k]).collect();
-            limit_line(&self.tu, &p, &mut m, mi);
+            let p: Vec<T> = ks.iter().map(|&k| self.p[k]).collect();
+            let mut m: Vec<T> = ks.iter().map(|&k| self.mu[k]).collect();
+            limit_line(&self.tu, &p, &mut m, mi, kinks, &|i| {
+                format!("knot ({i}, {j}), pˣ")
+            });
             for (&k, v) in ks.iter().zip(m) {
                 self.mu[k] = v;
             }
         }
         for i in 0..nu {
             let ks: Vec<usize> = (0..nv).map(|j| self.at(i, j)).collect();
-            let p: Vec<f64> = ks.iter().map(|&k| self.p[k]).collect();
-            let mut m: Vec<f64> = ks.iter().map(|&k| self.mv[k]).collect();
-            limit_line(&self.tv, &p, &mut m, mj);
+            let p: Vec<T> = ks.iter().map(|&k| self.p[k]).collect();
+            let mut m: Vec<T> = ks.iter().map(|&k| self.mv[k]).collect();
+            limit_line(&self.tv, &p, &mut m, mj, kinks, &|j| {
+                format!("knot ({i}, {j}), pʸ")
+            });
             for (&k, v) in ks.iter().zip(m) {
                 self.mv[k] = v;
             }
@@ -628,7 +689,13 @@ impl Grid {
 
     /// Step 5, patch interiors: halve the twists at the corners of failing patches (up to 40 rounds), then, when
     /// `strict`, shrink their cross slopes (up to 60 rounds).
-    fn monotone_patches(&mut self, min: &Minimum, pmin: f64, strict: bool) -> PatchRounds {
+    fn monotone_patches(
+        &mut self,
+        min: &Minimum,
+        pmin: f64,
+        strict: bool,
+        kinks: &mut Kinks,
+    ) -> PatchRounds {
         let mut rounds = PatchRounds::default();
         let mut failing = self.failing_patches(min.i, min.j);
         while !failing.is_empty() && rounds.twist < 40 {
@@ -645,7 +712,7 @@ impl Grid {
         }
         while strict && !failing.is_empty() && rounds.slope < 60 {
             rounds.slope += 1;
-            self.shrink_cross_slopes(&failing, min, pmin);
+            self.shrink_cross_slopes(&failing, min, pmin, kinks);
             failing = self.failing_patches(min.i, min.j);
         }
         rounds.nonmonotone = failing.len();
@@ -656,19 +723,31 @@ impl Grid {
     /// strongly between its corners (the ∂f/∂u of the patch contains hv k_j(t) ∂_u H[pʸ]); shrinking |pʸ| towards
     /// pˣ_min (keeping its sign, so the columns stay monotone and Fritsch–Carlson's box still holds) removes that
     /// term in the limit, and likewise |pˣ| for a failure along v. The corners' twists are set to 0.
-    fn shrink_cross_slopes(&mut self, failing: &[Failing], min: &Minimum, pmin: f64) {
+    fn shrink_cross_slopes(
+        &mut self,
+        failing: &[Failing],
+        min: &Minimum,
+        pmin: f64,
+        kinks: &mut Kinks,
+    ) {
         let mut seen = std::collections::HashSet::new();
+        let bound = T::from(pmin);
         for f in failing {
             for (i, j, k) in self.corners(f.cell) {
                 if !seen.insert(k) {
                     continue;
                 }
-                self.muv[k] = 0.0;
-                let shrink = |m: f64, free: bool| {
+                self.muv[k] = T::from(0.0);
+                let mut shrink = |m: T, free: bool| {
                     if free {
-                        0.5 * m
+                        m * 0.5
                     } else {
-                        (0.5 * m.abs()).max(pmin).copysign(m)
+                        let half = m.copysign_of(1.0) * 0.5;
+                        kinks
+                            .max(half, bound, KinkRule::CrossSlopeFloor, || {
+                                format!("knot ({i}, {j})")
+                            })
+                            .copysign_of(m.value())
                     }
                 };
                 if f.along_u {
@@ -683,14 +762,15 @@ impl Grid {
 
     /// Step 6: the residual r = f(u, v) − f(u, 0) − f(0, v) + f(0, 0) about the knots u = 0 (`i0`) and v = 0
     /// (`j0`), with exact zeros on both axes.
-    fn residual(&self, i0: usize, j0: usize) -> Grid {
+    fn residual(&self, i0: usize, j0: usize) -> Grid<T> {
         let (nu, nv) = (self.tu.len(), self.tv.len());
+        let zero = T::from(0.0);
         let mut r = Grid {
             tu: self.tu.clone(),
             tv: self.tv.clone(),
-            p: vec![0.0; nu * nv],
-            mu: vec![0.0; nu * nv],
-            mv: vec![0.0; nu * nv],
+            p: vec![zero; nu * nv],
+            mu: vec![zero; nu * nv],
+            mv: vec![zero; nu * nv],
             muv: self.muv.clone(),
         };
         for j in 0..nv {
@@ -705,13 +785,13 @@ impl Grid {
         // exact zeros on the axes (the formulas above give them up to rounding only when p(0,0) ≠ 0)
         for i in 0..nu {
             let k = r.at(i, j0);
-            r.p[k] = 0.0;
-            r.mu[k] = 0.0;
+            r.p[k] = zero;
+            r.mu[k] = zero;
         }
         for j in 0..nv {
             let k = r.at(i0, j);
-            r.p[k] = 0.0;
-            r.mv[k] = 0.0;
+            r.p[k] = zero;
+            r.mv[k] = zero;
         }
         r
     }
@@ -723,10 +803,11 @@ impl Grid {
             for i in 0..nu {
                 if (stretch[0] && self.tu[i] <= 0.0) || (stretch[1] && self.tv[j] <= 0.0) {
                     let k = self.at(i, j);
-                    self.p[k] = 0.0;
-                    self.mu[k] = 0.0;
-                    self.mv[k] = 0.0;
-                    self.muv[k] = 0.0;
+                    let zero = T::from(0.0);
+                    self.p[k] = zero;
+                    self.mu[k] = zero;
+                    self.mv[k] = zero;
+                    self.muv[k] = zero;
                 }
             }
         }
@@ -736,18 +817,19 @@ impl Grid {
     /// last row, pˣʸ on all four sides), so the residual stays constant beyond it.
     fn bound_extrapolation(&mut self) {
         let (nu, nv) = (self.tu.len(), self.tv.len());
+        let zero = T::from(0.0);
         for j in 0..nv {
             for i in [0, nu - 1] {
                 let k = self.at(i, j);
-                self.mu[k] = 0.0;
-                self.muv[k] = 0.0;
+                self.mu[k] = zero;
+                self.muv[k] = zero;
             }
         }
         for i in 0..nu {
             for j in [0, nv - 1] {
                 let k = self.at(i, j);
-                self.mv[k] = 0.0;
-                self.muv[k] = 0.0;
+                self.mv[k] = zero;
+                self.muv[k] = zero;
             }
         }
     }
@@ -764,41 +846,85 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
         });
     }
     check_options(opts)?;
+    let core = fit2d_core(x, y, psi, opts, &mut Kinks::off())?;
+    let full = core.full.spline();
+
+    // report on the unconverted spline
+    let mut err = super::RelError::default();
+    for ((&u, &v), &f) in core.xs.iter().zip(&core.ys).zip(&core.fs) {
+        err.add(full.eval2(u, v)[0], f);
+    }
+    let report = Fit2DReport {
+        n_samples: core.fs.len(),
+        n_excluded: core.n_excluded,
+        rms_rel: err.rms_rel(),
+        max_rel: err.max_rel(),
+        i_min: core.min.i,
+        j_min: core.min.j,
+        twist_rounds: core.rounds.twist,
+        slope_rounds: core.rounds.slope,
+        nonmonotone_patches: core.rounds.nonmonotone,
+        compression_nonmonotone: core.compression.nonmonotone,
+    };
+    Ok(Fit2D {
+        residual: core.residual.spline(),
+        full,
+        report,
+    })
+}
+
+/// FIT2D steps 1–8 over a [`FitScalar`]: the unconverted grid f, the residual grid r, and what the report
+/// needs. Knots, minimum knots, patch certificates and every branch are decided on the real parts; `kinks`
+/// records the decisions at their switching points.
+pub(crate) struct Core2D<T> {
+    full: Grid<T>,
+    pub(crate) residual: Grid<T>,
+    min: Minimum,
+    rounds: PatchRounds,
+    compression: PatchRounds,
+    /// the usable samples (real Ψ) and how many were excluded
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+    fs: Vec<f64>,
+    n_excluded: usize,
+}
+
+/// The core of [`fit2d`] on scalars `psi` (lengths and options checked by the caller).
+pub(crate) fn fit2d_core<T: FitScalar>(
+    x: &[f64],
+    y: &[f64],
+    psi: &[T],
+    opts: &Fit2DOptions,
+    kinks: &mut Kinks,
+) -> Result<Core2D<T>, FitError> {
     let (xs, ys, fs) = usable_samples(x, y, psi);
     let n_excluded = psi.len() - fs.len();
 
     // step 1
-    let g = Smoothed::new(&xs, &ys, &fs, opts)?;
+    let g = Smoothed::new((&xs, &ys, &fs), opts, kinks)?;
     // step 2
     let mut grid = Grid::sample(&g, &xs, &ys, opts)?;
     // step 3
-    let min = grid.minimum(opts.minimum_v);
+    let min = grid.minimum(opts.minimum_v, kinks);
     let pmin = opts.min_slope;
     if opts.quasi_convex {
-        grid.quasi_convexify(&min, pmin);
+        grid.quasi_convexify(&min, pmin, kinks);
     }
     // step 4 (applied again after step 5 so the Fritsch–Carlson zeroing of (s_x, s_y) cannot undo it)
-    grid.clamp_boundary(pmin);
+    grid.clamp_boundary(pmin, kinks);
     // step 5: Fritsch–Carlson along rows and columns, then the patches
     let (mi, mj) = if opts.quasi_convex {
         (Some(min.i), Some(min.j))
     } else {
         (None, None)
     };
-    grid.limit_lines(mi, mj);
-    grid.clamp_boundary(pmin);
+    grid.limit_lines(mi, mj, kinks);
+    grid.clamp_boundary(pmin, kinks);
     let rounds = if opts.quasi_convex {
-        grid.monotone_patches(&min, pmin, opts.strict_patches)
+        grid.monotone_patches(&min, pmin, opts.strict_patches, kinks)
     } else {
         PatchRounds::default()
     };
-    let full = grid.spline();
-
-    // report on the unconverted spline
-    let mut err = super::RelError::default();
-    for ((&u, &v), &f) in xs.iter().zip(&ys).zip(&fs) {
-        err.add(full.eval2(u, v)[0], f);
-    }
 
     // step 6
     let mut r = grid.residual(min.i, min.j0);
@@ -806,30 +932,23 @@ pub fn fit2d(x: &[f64], y: &[f64], psi: &[f64], opts: &Fit2DOptions) -> Result<F
     let mut compression = PatchRounds::default();
     if opts.quasi_convex {
         if opts.compression_residual {
-            compression = r.compression_excess(opts.stretch, min.i, min.j0);
+            compression = r.compression_excess(opts.stretch, min.i, min.j0, kinks);
         } else {
             r.zero_compression(opts.stretch);
         }
     }
     // step 8
     r.bound_extrapolation();
-
-    let report = Fit2DReport {
-        n_samples: fs.len(),
+    Ok(Core2D {
+        full: grid,
+        residual: r,
+        min,
+        rounds,
+        compression,
+        xs,
+        ys,
+        fs: fs.iter().map(|v| v.value()).collect(),
         n_excluded,
-        rms_rel: err.rms_rel(),
-        max_rel: err.max_rel(),
-        i_min: min.i,
-        j_min: min.j,
-        twist_rounds: rounds.twist,
-        slope_rounds: rounds.slope,
-        nonmonotone_patches: rounds.nonmonotone,
-        compression_nonmonotone: compression.nonmonotone,
-    };
-    Ok(Fit2D {
-        residual: r.spline(),
-        full,
-        report,
     })
 }
 

@@ -182,7 +182,7 @@ fn a_sign_change_of_the_derivative_next_to_a_flat_edge_is_found_and_repaired() {
     assert!(failing[0].along_u && !failing[0].along_v);
 
     let p = g.p.clone();
-    let rounds = g.monotone_patches(&min, 1e-3, true);
+    let rounds = g.monotone_patches(&min, 1e-3, true, &mut crate::fit::scalar::Kinks::off());
     assert_eq!(rounds.nonmonotone, 0);
     assert!(g.failing_patches(min.i, min.j).is_empty());
     // two halvings of the corner twists suffice; values and slopes stay (C¹ by construction)
