@@ -38,3 +38,13 @@ fn solve_short_help_fits_a_screen() {
     let n = help(&["solve", "-h"]).lines().count();
     assert!(n <= 40, "hylc solve -h: {n} lines");
 }
+
+#[test]
+fn completions_name_every_command() {
+    for shell in ["bash", "zsh", "fish"] {
+        let text = help(&["completions", shell]);
+        for name in ["simulate", "gradient", "sample", "fit", "check-derivatives"] {
+            assert!(text.contains(name), "{shell}: {name} missing");
+        }
+    }
+}

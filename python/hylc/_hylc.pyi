@@ -123,4 +123,6 @@ def gradient(
     material: Optional[str] = None,
     out: Optional[StrPath] = None,
     check: bool = False,
+    samples: Optional[StrPath] = None,
+    yarn: Yarn = None,
 ) -> dict[str, Any]: ...

@@ -4,7 +4,8 @@
 use crate::arrays::rows;
 use crate::convert::json_to_numpy;
 use crate::errors::{detached, HyError};
-use hylc::workflow::gradient::{gradient as run_gradient, GradientOptions};
+use crate::yarn::yarn_of;
+use hylc::workflow::gradient::{gradient as run_gradient, GradientOptions, YarnChainInput};
 use hylc::workflow::simulate::{prepare, Overrides};
 use pyo3::prelude::*;
 use std::path::PathBuf;
@@ -17,10 +18,12 @@ use std::path::PathBuf;
 /// central differences of re-solves. Returns the content of `gradient.json` as dicts of numpy arrays:
 /// `value`, `time`, `residual`, `scene` (`stiffness`, `bending_scale`, `mass`, `gravity`), `held` (per held set
 /// `translation` (3,) and `keyframes` (k, 3)), `obstacles` (n, 3), `material` (the material file's layout with
-/// dJ/dc in place of each coefficient) and `check`. The frames and the log go to `out` (a temporary folder by
-/// default).
+/// dJ/dc in place of each coefficient) and `check`. With `samples` (the sample file the material was fitted to,
+/// made with `sensitivities`) and `yarn` (its yarn parameters: a dict, a file or None for the defaults) also
+/// `yarn` (name → dJ/dθ) and `yarn_chain` (the fit's kinks, samples used). The frames and the log go to `out`
+/// (a temporary folder by default).
 #[pyfunction]
-#[pyo3(signature = (scene, observable=None, cotangent=None, at=None, material=None, out=None, check=false))]
+#[pyo3(signature = (scene, observable=None, cotangent=None, at=None, material=None, out=None, check=false, samples=None, yarn=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn gradient<'py>(
     py: Python<'py>,
@@ -31,7 +34,31 @@ pub fn gradient<'py>(
     material: Option<String>,
     out: Option<PathBuf>,
     check: bool,
+    samples: Option<PathBuf>,
+    yarn: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let yarn_chain = match samples {
+        Some(samples) => {
+            let yarn_label = match &yarn {
+                Some(y) if y.extract::<PathBuf>().is_ok() => {
+                    y.extract::<PathBuf>()?.display().to_string()
+                }
+                Some(_) => "yarn (a dict)".to_string(),
+                None => "the default yarn".to_string(),
+            };
+            Some(YarnChainInput {
+                samples,
+                yarn: yarn_of(yarn.as_ref())?,
+                yarn_label,
+            })
+        }
+        None if yarn.is_some() => {
+            return Err(
+                HyError::value("gradient: yarn needs samples (the material's sample file)").into(),
+            )
+        }
+        None => None,
+    };
     let cotangent = match cotangent {
         Some(c) => {
             let r = rows(&c, "cotangent", &[3])?;
@@ -54,6 +81,7 @@ pub fn gradient<'py>(
         at,
         check,
         check_coefficients: 5,
+        yarn: yarn_chain,
     };
     let ov = Overrides {
         material,

@@ -38,8 +38,9 @@ def cli_json(cli):
 
 @pytest.fixture(scope="session")
 def quick_samples(cli, tmp_path_factory):
-    """The quick plan sampled on the generated plain weave by the CLI (a sample file with its sidecar)."""
+    """The quick plan sampled on the generated plain weave by the CLI (a sample file with its sidecar), with the
+    samples' sensitivities to the yarn parameters."""
     path = tmp_path_factory.mktemp("samples") / "plain.jsonl"
-    cli("sample", "plain", "--plan", "quick", "--out", path, check=False)
+    cli("sample", "plain", "--plan", "quick", "--out", path, "--sensitivities", check=False)
     assert path.exists()
     return path

@@ -172,6 +172,23 @@ def test_gradient_equals_the_cli_and_the_vjp_equals_a_target(tmp_path, cli):
         hylc.gradient(str(tmp_path / "damped.json"), observable="energy")
 
 
+def test_yarn_chain_equals_the_cli(tmp_path, cli, quick_samples):
+    material = tmp_path / "plain.material.json"
+    cli("fit", quick_samples, "--out", material, "--no-plots")
+    scene = _quasi_static_stretch(tmp_path, cli)
+    cli("gradient", scene, "--observable", "energy", "--material", material, "--samples", quick_samples,
+        "--out", tmp_path / "cli", "--quiet")
+    expected = json.loads((tmp_path / "cli" / "gradient.json").read_text())["yarn"]
+    g = hylc.gradient(scene, observable="energy", material=str(material), samples=quick_samples)
+    assert list(g["yarn"]) == ["young", "shear", "bend_twist_factor", "contact_stiffness", "contact_radius_factor",
+                               "radius"]
+    for k, v in expected.items():
+        assert g["yarn"][k] == pytest.approx(v, rel=1e-12, abs=1e-300)
+    assert g["yarn_chain"]["reference_state"] == "held fixed"
+    with pytest.raises(ValueError, match="yarn needs samples"):
+        hylc.gradient(scene, observable="energy", material=str(material), yarn={"young": 1e6})
+
+
 def test_vtu_series_reads_back_with_meshio(tmp_path, cli):
     meshio = pytest.importorskip("meshio")
     import xml.etree.ElementTree as ET

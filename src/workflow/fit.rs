@@ -68,7 +68,7 @@ fn beside_name(f: &Path, out: &Path) -> String {
 }
 
 /// The plan of the samples: the given one, else the sidecar's, else the built-in plan whose hash the ids carry.
-fn find_plan(
+pub(super) fn find_plan(
     arg: Option<&str>,
     meta: Option<&serde_json::Map<String, serde_json::Value>>,
     records: &[Record],
@@ -100,7 +100,7 @@ fn find_plan(
 }
 
 /// The areal density: the given one, else the sidecar's.
-fn find_density(
+pub(super) fn find_density(
     given: Option<f64>,
     meta: Option<&serde_json::Map<String, serde_json::Value>>,
     samples: &Path,

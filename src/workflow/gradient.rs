@@ -10,6 +10,7 @@
 //! `target:FILE.obj` (½ Σ_v |x_v − x̂_v|² against an OBJ with the scene's vertices).
 
 use super::simulate::run_reporting;
+use super::yarn_chain::{yarn_gradient, YarnGradient};
 use super::{write_file, Event, WorkflowError};
 use crate::material::coefficients::Coefficient;
 use crate::shell::mesh::load_obj_surface;
@@ -35,6 +36,18 @@ pub struct GradientOptions {
     /// `check_coefficients` material coefficients with the largest |c dJ/dc|
     pub check: bool,
     pub check_coefficients: usize,
+    /// also dJ/dθ for the yarn parameters through the samples the material was fitted to
+    /// ([`super::yarn_chain`])
+    pub yarn: Option<YarnChainInput>,
+}
+
+/// The samples (made with `--sensitivities`) and yarn parameters of the yarn chain.
+#[derive(Clone, Debug)]
+pub struct YarnChainInput {
+    pub samples: std::path::PathBuf,
+    pub yarn: crate::rod::YarnMaterial,
+    /// how the yarn parameters are named in messages (their file)
+    pub yarn_label: String,
 }
 
 /// One row of the finite-difference check.
@@ -50,6 +63,8 @@ pub struct CheckRow {
 /// The gradient, its JSON (`gradient.json`) and the check.
 pub struct GradientOutcome {
     pub sensitivity: Sensitivity,
+    /// dJ/dθ, with [`GradientOptions::yarn`]
+    pub yarn: Option<YarnGradient>,
     /// the time of the equilibrium (s)
     pub time: f64,
     pub json: Value,
@@ -200,6 +215,18 @@ pub fn gradient(
         sim.trajectory_sensitivity(&obs, &[last], true)
             .map_err(|e| unsupported(scene_arg, e))?
     };
+    let yarn = match (&opts.yarn, &sens.material) {
+        (Some(y), Some(djdc)) => Some(yarn_gradient(
+            &sim.model.material,
+            &scene.material,
+            djdc,
+            sens.mass_scale,
+            &y.samples,
+            &y.yarn,
+            &y.yarn_label,
+        )?),
+        _ => None,
+    };
     let wall_gradient = t0.elapsed().as_secs_f64();
     let check = if opts.check {
         let p = Probe {
@@ -213,13 +240,14 @@ pub fn gradient(
     } else {
         vec![]
     };
-    let json = to_json(&scene, &sim, opts, &sens, &check);
+    let json = to_json(&scene, &sim, opts, &sens, &check, yarn.as_ref());
     write_file(
         &out.join("gradient.json"),
         serde_json::to_string_pretty(&json).expect("a JSON value serialises"),
     )?;
     Ok(GradientOutcome {
         sensitivity: sens,
+        yarn,
         time: sim.time,
         json,
         check,
@@ -235,6 +263,7 @@ fn to_json(
     opts: &GradientOptions,
     sens: &Sensitivity,
     check: &[CheckRow],
+    yarn: Option<&YarnGradient>,
 ) -> Value {
     let held: serde_json::Map<String, Value> = sens
         .held
@@ -264,6 +293,14 @@ fn to_json(
         "held": held,
         "obstacles": sens.obstacles,
         "material": material,
+        "yarn": yarn.map(|y| y.values.iter().map(|(k, v)| (k.to_string(), json!(v))).collect::<serde_json::Map<_, _>>()),
+        "yarn_chain": yarn.map(|y| json!({
+            "samples": opts.yarn.as_ref().map(|i| i.samples.display().to_string()),
+            "fitted_samples": y.samples,
+            "kinks": y.kinks,
+            "reference_state": "held fixed",
+            "wall": y.wall,
+        })),
         "check": check.iter().map(|r| json!({
             "parameter": r.parameter,
             "adjoint": r.adjoint,

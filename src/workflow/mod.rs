@@ -32,6 +32,7 @@ pub mod inputs;
 pub mod pipeline;
 pub mod sidecar;
 pub mod simulate;
+pub mod yarn_chain;
 
 use std::path::{Path, PathBuf};
 

@@ -1,8 +1,9 @@
 //! `hylc gradient SCENE --observable OBS`: dJ/dp of one observable of a scene by an adjoint solve
 //! (`hylc::workflow::gradient`, docs/sensitivities.md), written to `OUT/gradient.json`.
 
+use crate::args::YarnArgs;
 use crate::printer::Printer;
-use hylc::workflow::gradient::{gradient, no_gradient, GradientOptions};
+use hylc::workflow::gradient::{gradient, no_gradient, GradientOptions, YarnChainInput};
 use hylc::workflow::simulate::{prepare_noted, Overrides};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -38,6 +39,12 @@ pub struct Args {
     /// how many material coefficients --check compares (those with the largest |c dJ/dc|)
     #[arg(long, default_value_t = 5, value_name = "N")]
     check_coefficients: usize,
+    /// the sample file the material was fitted to, made with `hylc sample --sensitivities`: adds dJ/dθ for
+    /// every yarn parameter (the reference state held fixed; docs/sensitivities.md, "The chain to the yarn")
+    #[arg(long, value_name = "SAMPLES.jsonl")]
+    samples: Option<PathBuf>,
+    #[command(flatten)]
+    yarn: YarnArgs,
     /// no progress bar
     #[arg(long)]
     quiet: bool,
@@ -56,6 +63,18 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         at: a.at,
         check: a.check,
         check_coefficients: a.check_coefficients,
+        yarn: match a.samples {
+            Some(samples) => Some(YarnChainInput {
+                samples,
+                yarn: a.yarn.material()?,
+                yarn_label: a
+                    .yarn
+                    .yarn
+                    .as_ref()
+                    .map_or("(defaults)".into(), |p| p.display().to_string()),
+            }),
+            None => None,
+        },
     };
     let o = match gradient(&scene, &a.scene, &dir, &a.out, &opts, &mut |e| {
         printer.show(e)
@@ -93,6 +112,25 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
             "dJ/d translation of obstacle {i}: [{:.6e}, {:.6e}, {:.6e}]",
             t[0], t[1], t[2]
         );
+    }
+    if let Some(y) = &o.yarn {
+        let parts: Vec<String> = y
+            .values
+            .iter()
+            .map(|(k, v)| format!("{k} {v:.6e}"))
+            .collect();
+        println!(
+            "dJ/dθ (yarn, through {} samples and the fit, reference state held fixed): {}",
+            y.samples,
+            parts.join(", ")
+        );
+        if !y.kinks.is_empty() {
+            println!(
+                "the fit has {} decisions at their switching point (one-sided derivatives), first: {}",
+                y.kinks.len(),
+                y.kinks[0]
+            );
+        }
     }
     if !o.check.is_empty() {
         println!(

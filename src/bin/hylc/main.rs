@@ -6,6 +6,7 @@ mod args;
 mod calibrate;
 mod check_derivatives;
 mod compare_samples;
+mod completions;
 mod fit;
 mod fuzz;
 mod generate;
@@ -75,6 +76,9 @@ Verification and validation:
   micro-grid         The micro solver against the original displacements
   fuzz               Mutated inputs through every parser and evaluator
 
+Shell:
+  completions        A completion script for bash, zsh, fish, elvish or PowerShell
+
 Options:
 {options}
 
@@ -83,7 +87,7 @@ Options:
 
 #[derive(Parser)]
 #[command(name = "hylc", version = VERSION, about = "Homogenized yarn-level cloth", help_template = GROUPED_HELP)]
-struct Cli {
+pub(crate) struct Cli {
     #[command(subcommand)]
     command: Command,
 }
@@ -112,6 +116,7 @@ enum Command {
     Simulate(simulate::Args),
     Gradient(gradient::Args),
     Yarn(yarn::Args),
+    Completions(completions::Args),
 }
 
 /// The command line, or exit: help and version are printed as clap prints them, a usage error as one line
@@ -178,6 +183,7 @@ fn main() -> ExitCode {
         Command::Simulate(a) => simulate::run(a),
         Command::Gradient(a) => gradient::run(a),
         Command::Yarn(a) => yarn::run(a),
+        Command::Completions(a) => completions::run(a),
     };
     match result {
         Ok(code) => code,
