@@ -61,6 +61,9 @@ pub struct FitOptions {
     /// false fits the two signs of shear separately (the knits' Ψ̄ is not even: honeycomb's rest state carries a
     /// shear stress, and its Ψ̄ at s_a = ±0.75 is 3.43 against 2.31 J/m²)
     pub symmetric_shear: bool,
+    /// the central-difference step of the knot slopes of every term, as a fraction of the knot spacing (default
+    /// 1e-3; [`Fit1DOptions::fd_step`], [`Fit2DOptions::fd_step`])
+    pub fd_step: f64,
 }
 
 impl Default for FitOptions {
@@ -80,6 +83,7 @@ impl Default for FitOptions {
             strict_patches: true,
             compression_residual: false,
             symmetric_shear: true,
+            fd_step: 1e-3,
         }
     }
 }
@@ -409,7 +413,7 @@ pub(super) fn options_1d(k: usize, opts: &FitOptions) -> Fit1DOptions {
         } else {
             MinimumAt::Argmin
         },
-        fd_step: 1e-3,
+        fd_step: opts.fd_step,
         slopes: opts.slopes,
     }
 }
@@ -526,7 +530,7 @@ pub(super) fn options_2d(k0: usize, k1: usize, opts: &FitOptions) -> Fit2DOption
             MinimumAt::Argmin
         },
         stretch: [stretch(k0), stretch(k1)],
-        fd_step: 1e-3,
+        fd_step: opts.fd_step,
         strict_patches: opts.strict_patches,
         compression_residual: opts.compression_residual,
     }
@@ -687,6 +691,9 @@ fn meta_block(
         }
         if opts.extent_1d != FitOptions::default().extent_1d {
             o.insert("extent_1d".into(), serde_json::json!(opts.extent_1d));
+        }
+        if opts.fd_step != FitOptions::default().fd_step {
+            o.insert("fd_step".into(), serde_json::json!(opts.fd_step));
         }
     }
     meta.insert(
