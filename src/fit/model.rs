@@ -29,7 +29,7 @@ use serde::Serialize;
 /// Options of the whole fit; [`Default`] gives the design's defaults. A fitted material records them in its
 /// `meta["fit options"]` (the same keys), so that it can be refitted as it was made.
 #[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct FitOptions {
     /// N_c of FIT1D (default 11)
     pub n_knots_1d: usize,
@@ -63,6 +63,9 @@ pub struct FitOptions {
     /// false fits the two signs of shear separately (the knits' Ψ̄ is not even: honeycomb's rest state carries a
     /// shear stress, and its Ψ̄ at s_a = ±0.75 is 3.43 against 2.31 J/m²)
     pub symmetric_shear: bool,
+    /// the central-difference step of the knot slopes of every term, as a fraction of the knot spacing (default
+    /// 1e-3; [`Fit1DOptions::fd_step`], [`Fit2DOptions::fd_step`])
+    pub fd_step: f64,
 }
 
 impl Default for FitOptions {
@@ -82,6 +85,7 @@ impl Default for FitOptions {
             strict_patches: true,
             compression_residual: false,
             symmetric_shear: true,
+            fd_step: 1e-3,
         }
     }
 }
@@ -411,7 +415,7 @@ pub(super) fn options_1d(k: usize, opts: &FitOptions) -> Fit1DOptions {
         } else {
             MinimumAt::Argmin
         },
-        fd_step: 1e-3,
+        fd_step: opts.fd_step,
         slopes: opts.slopes,
     }
 }
@@ -528,7 +532,7 @@ pub(super) fn options_2d(k0: usize, k1: usize, opts: &FitOptions) -> Fit2DOption
             MinimumAt::Argmin
         },
         stretch: [stretch(k0), stretch(k1)],
-        fd_step: 1e-3,
+        fd_step: opts.fd_step,
         strict_patches: opts.strict_patches,
         compression_residual: opts.compression_residual,
     }
