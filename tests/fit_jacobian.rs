@@ -51,6 +51,8 @@ fn records(plan: &Plan) -> Vec<Record> {
                 starts: vec![],
                 kept: None,
                 crossings: None,
+                dpsi_dtheta: None,
+                dstress_dtheta: None,
             }
         })
         .collect()
