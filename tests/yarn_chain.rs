@@ -202,5 +202,21 @@ fn yarn_gradient_agrees_with_differences_of_the_pipeline() {
         "old.material.json",
         "fit options",
     );
+    // the pattern's radius is the one the samples were solved with: a yarn file's other radius stands for it
+    let mut y = yarn0.clone();
+    y["radius"] = (2.0 * yarn0["radius"].as_f64().unwrap()).into();
+    std::fs::write(d.join("yarn_radius.json"), y.to_string()).unwrap();
+    let g2 = energy(
+        &d,
+        "base/material.json",
+        "base/gradient2",
+        &[
+            "--samples",
+            "base/samples.jsonl",
+            "--yarn",
+            "yarn_radius.json",
+        ],
+    );
+    assert_eq!(g2["yarn"], g["yarn"]);
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -65,7 +65,7 @@ fn recorded_options(material: &Material, label: &str) -> Result<FitOptions, Work
     })
 }
 
-/// The sample file's yarn parameters (its sidecar's `yarn`) must be `yarn`.
+/// The sample file's yarn parameters (its sidecar's `yarn`) must be `yarn` (with the pattern's radius).
 fn check_yarn(
     meta: &serde_json::Map<String, serde_json::Value>,
     yarn: &YarnMaterial,
@@ -113,7 +113,11 @@ pub fn yarn_gradient(
             samples.display()
         ))
     })?;
-    check_yarn(&meta, yarn, samples, yarn_label)?;
+    // a micro problem takes its pattern's radius: the yarn file's stands for it
+    let r = sampled_radius(&meta, samples)?;
+    let mut yarn = yarn.clone();
+    yarn.radius = r;
+    check_yarn(&meta, &yarn, samples, yarn_label)?;
     let plan = find_plan(None, Some(&meta), &records, samples)?;
     let density = find_density(None, Some(&meta), samples)?;
     let opts = recorded_options(material, material_label)?;
@@ -153,7 +157,6 @@ pub fn yarn_gradient(
         source,
     })?;
     belongs_together(material, &fit.material, material_label, samples)?;
-    let r = sampled_radius(&meta, samples)?;
     let values = YarnParameter::ALL
         .iter()
         .zip(&dcs)
