@@ -133,7 +133,10 @@ def write(a, results):
         for key in ["sag", "energy", "force"]:
             r = row.get(key, {})
             if "error" in r:
-                lines.append(f"| {pat} | {key} | no gradient: {r['error']} |" + " |" * (len(PARAMS) + 1))
+                reason = r["error"].removeprefix("error: ")
+                if "did not converge" in reason:
+                    reason = "the step did not converge (Newton, even with the step halved 6 times)"
+                lines.append(f"| {pat} | {key} | no gradient: {reason} |" + " |" * (len(PARAMS) + 1))
                 continue
             lines.append(f"| {pat} | {key} | {r['J']:.4e} | " + " | ".join(f"{r['normalised'][p]:+.3f}" for p in PARAMS)
                          + f" | {r['kinks']} |")
@@ -154,13 +157,14 @@ def write(a, results):
             if "normalised" not in r:
                 continue
             xs = [k + (i - (len(results) - 1) / 2) * width for k in range(len(PARAMS))]
-            ax.bar(xs, [r["normalised"][p] for p in PARAMS], width, label=pat)
+            ax.bar(xs, [r["normalised"][p] for p in PARAMS], width, label=pat, color=f"C{i}")
         ax.set_xticks(range(len(PARAMS)))
         ax.set_xticklabels(["Y", "G", "γ", "k_c", "f", "r"])
         ax.axhline(0, color="k", lw=0.5)
         ax.set_title({"sag": "drape sag", "energy": "drape elastic energy", "force": "stretch handle force, 0.3 s"}[key])
         ax.set_ylabel("(θ/J) dJ/dθ")
-    axes[0].legend(fontsize=8)
+    handles = [plt.Rectangle((0, 0), 1, 1, color=f"C{i}") for i in range(len(results))]
+    axes[0].legend(handles, list(results), fontsize=8)
     fig.tight_layout()
     fig.savefig(a.plot, dpi=110)
     print(f"wrote {a.results} and {a.plot}")
