@@ -268,10 +268,16 @@ fn fit_bad_input_is_one_line() {
     // the ids belong to the reduced plan, not the default one
     let err = cli_error(&["fit", &sp, "--density", "0.3", "--plan", "default"]);
     assert!(err.contains("does not belong to plan"), "{err}");
-    // no samples at all
+    // a file that does not exist, and one without samples
     let missing = d.join("missing.jsonl").display().to_string();
     let err = cli_error(&["fit", &missing, "--density", "0.3"]);
-    assert!(err.contains("no samples"), "{err}");
+    assert!(err.contains("missing.jsonl: no such sample file"), "{err}");
+    let err = cli_error(&["fit", &sp, "--density", "0.3", "--holdout", &missing]);
+    assert!(err.contains("missing.jsonl: no such sample file"), "{err}");
+    let empty = d.join("empty.jsonl");
+    std::fs::write(&empty, "").unwrap();
+    let err = cli_error(&["fit", empty.to_str().unwrap(), "--density", "0.3"]);
+    assert!(err.contains("empty.jsonl: no samples"), "{err}");
     // a bad option value
     let err = cli_error(&["fit", &sp, "--density", "0.3", "--slopes", "magic"]);
     assert!(err.contains("--slopes"), "{err}");

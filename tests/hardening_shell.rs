@@ -411,3 +411,31 @@ fn simulate_exits_3_when_a_step_fails_even_halved_and_0_when_complete() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// A scene with duration 0 runs (frame 0 only) and says so in one warning line.
+#[test]
+fn duration_zero_warns_once() {
+    let out = std::env::temp_dir().join(format!("hylc-duration0-{}", std::process::id()));
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_hylc"))
+        .args([
+            "simulate",
+            "stretch-x",
+            "--duration",
+            "0",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    let warnings: Vec<&str> = err.lines().filter(|l| l.contains("duration 0")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(
+        warnings[0].starts_with("warning: duration 0 s: no step is simulated"),
+        "{err}"
+    );
+    assert!(out.join("frame_0000.obj").exists());
+    let _ = std::fs::remove_dir_all(&out);
+}

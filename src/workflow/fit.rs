@@ -137,6 +137,14 @@ pub fn fit_samples(
 ) -> Result<FitReport, WorkflowError> {
     let t0 = Instant::now();
     let samples = job.samples.as_path();
+    for f in std::iter::once(samples).chain(job.holdout.iter().map(|h| h.as_path())) {
+        if !f.exists() {
+            return Err(WorkflowError::Input(format!(
+                "{}: no such sample file",
+                f.display()
+            )));
+        }
+    }
     let records = read_samples(samples, false)?;
     if records.is_empty() {
         return Err(WorkflowError::Input(format!(

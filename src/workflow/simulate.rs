@@ -132,6 +132,11 @@ pub fn prepare_noted(
     scene.model.only_1d |= ov.only_1d;
     scene.model.in_plane_only |= ov.in_plane_only;
     scene.output.vtu |= ov.vtu;
+    if scene.duration == 0.0 {
+        on_event(Event::Note(
+            "warning: duration 0 s: no step is simulated, only frame 0 (the initial state) is written",
+        ));
+    }
     Ok((scene, dir))
 }
 
