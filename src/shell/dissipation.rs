@@ -116,6 +116,32 @@ pub fn drag_reference<D: Real>(f: &DragFace, wind: &Wind, h: f64, x: &[D]) -> D 
     (un3 * (wind.density / 3.0) + ut2 * (wind.drag / 2.0)) * (h * f.area)
 }
 
+/// Π_f of [`drag`] as a function of both the positions `x` and the positions `xn` the face is lagged at (9 each):
+/// the normal n = (e₁ × e₂)/|e₁ × e₂| of `xn` (as [`drag_face`] makes it) and the velocity's origin, generic over
+/// the scalar (the trajectory adjoint differentiates μᵀ∇_xΠ_f with respect to `xn` by forward-mode AD).
+pub fn drag_lagged_reference<D: Real>(area: f64, wind: &Wind, h: f64, x: &[D], xn: &[D]) -> D {
+    let p = |a: usize| crate::real::v3(&xn[3 * a..]);
+    let (p0, p1, p2) = (p(0), p(1), p(2));
+    let m = crate::real::cross(&crate::real::sub(&p1, &p0), &crate::real::sub(&p2, &p0));
+    let l = crate::real::norm(&m);
+    let n: Vec<D> = m.iter().map(|mk| mk.clone() / l.clone()).collect();
+    let u: Vec<D> = (0..3)
+        .map(|k| {
+            let s = (0..3).fold(c::<D>(0.0), |acc, a| {
+                acc + x[3 * a + k].clone() - xn[3 * a + k].clone()
+            });
+            -(s / (3.0 * h)) + wind.velocity[k]
+        })
+        .collect();
+    let un = (0..3).fold(c::<D>(0.0), |acc, k| acc + u[k].clone() * n[k].clone());
+    let ut2 = (0..3).fold(c::<D>(0.0), |acc, k| {
+        let t = u[k].clone() - un.clone() * n[k].clone();
+        acc + t.clone() * t
+    });
+    let un3 = un.clone() * un.clone() * un.abs();
+    (un3 * (wind.density / 3.0) + ut2 * (wind.drag / 2.0)) * (h * area)
+}
+
 /// The unit normal and rest-area data of a face at xₙ (`None` for a degenerate face).
 pub fn drag_face(xn: [[f64; 3]; 3], area: f64) -> Option<DragFace> {
     let e1: [f64; 3] = std::array::from_fn(|k| xn[1][k] - xn[0][k]);
@@ -153,4 +179,58 @@ pub fn damping_reference<D: Real>(hess: &[[f64; 18]; 18], c_over_h: f64, dq: &[D
         }
     }
     acc * (0.5 * c_over_h)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Const, U1};
+    use num_dual::{Dual, DualSVec64};
+
+    /// ∇_{xₙ}(μᵀ∇_xΠ) by AD of [`drag_lagged_reference`] equals central differences of [`drag`]'s gradient over
+    /// faces re-made at moved xₙ, and the generic value equals [`drag`]'s.
+    #[test]
+    fn lagged_drag_derivative_matches_differences() {
+        let wind = Wind {
+            density: 1.2,
+            drag: 0.5,
+            velocity: [0.3, -0.2, 1.0],
+        };
+        let (h, area) = (1.0 / 120.0, 2e-4);
+        let xn = [0.0, 0.0, 0.0, 0.02, 0.001, 0.002, 0.003, 0.021, -0.001];
+        let x: [f64; 9] = std::array::from_fn(|i| xn[i] + 1e-3 * ((i * 7 % 5) as f64 - 2.0));
+        let mu: [f64; 9] = std::array::from_fn(|i| ((i * 3 % 4) as f64 - 1.5) * 0.7);
+        let face = |xn: &[f64; 9]| {
+            drag_face(
+                std::array::from_fn(|a| [xn[3 * a], xn[3 * a + 1], xn[3 * a + 2]]),
+                area,
+            )
+            .unwrap()
+        };
+        let mug = |xn: &[f64; 9]| -> f64 {
+            let (_, g, _) = drag(&face(xn), &wind, h, &x);
+            (0..9).map(|i| mu[i] * g[i]).sum()
+        };
+        let v = drag_lagged_reference(area, &wind, h, &x, &xn);
+        assert!((v - drag(&face(&xn), &wind, h, &x).0).abs() <= 1e-14 * v.abs());
+        type D9 = DualSVec64<9>;
+        let xd: Vec<Dual<D9>> = (0..9)
+            .map(|i| Dual::new(D9::from_re(x[i]), D9::from_re(mu[i])))
+            .collect();
+        let xnd: Vec<Dual<D9>> = (0..9)
+            .map(|i| Dual::new(D9::from_re(xn[i]).derivative(i), D9::from_re(0.0)))
+            .collect();
+        let p = drag_lagged_reference(area, &wind, h, &xd, &xnd);
+        assert!((p.eps.re - mug(&xn)).abs() <= 1e-12 * mug(&xn).abs());
+        let g = p.eps.eps.unwrap_generic(Const::<9>, U1);
+        let gs = g.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+        for i in 0..9 {
+            let d = 1e-7;
+            let (mut a, mut b) = (xn, xn);
+            a[i] += d;
+            b[i] -= d;
+            let fd = (mug(&a) - mug(&b)) / (2.0 * d);
+            assert!((g[i] - fd).abs() <= 1e-6 * gs, "{i}: {} vs {fd}", g[i]);
+        }
+    }
 }

@@ -112,7 +112,7 @@ impl ElementModel {
     }
 
     #[inline]
-    fn flaps(&self, flaps: [bool; 3]) -> [bool; 3] {
+    pub(super) fn flaps(&self, flaps: [bool; 3]) -> [bool; 3] {
         if self.bending {
             flaps
         } else {
@@ -122,7 +122,7 @@ impl ElementModel {
 
     /// The strain ψ receives: S z.
     #[inline]
-    fn scaled(&self, z: &[f64; 6]) -> [f64; 6] {
+    pub(super) fn scaled(&self, z: &[f64; 6]) -> [f64; 6] {
         let b = self.bending_scale;
         [z[0], z[1], z[2], b * z[3], b * z[4], b * z[5]]
     }
@@ -130,7 +130,7 @@ impl ElementModel {
     /// ψ(S z) and its derivatives in z-space before the chain rule (S applied by [`Self::weights`]), plus the
     /// collapse barrier's density; `None` when a triangle has collapsed (J ≤ 0).
     #[inline]
-    fn psi(&self, z: &[f64; 6]) -> Option<crate::material::PsiVgh> {
+    pub(super) fn psi(&self, z: &[f64; 6]) -> Option<crate::material::PsiVgh> {
         let mut p = self.material.eval(&self.scaled(z));
         if let Some(c) = &self.collapse {
             c.add_to(z, &mut p.value, &mut p.grad, &mut p.hess)?;
@@ -235,7 +235,7 @@ impl ElementModel {
 
     /// c = A k and the weights A k S ∇ψ.
     #[inline]
-    fn weights(&self, rest: &RestTriangle, g: &[f64; 6]) -> (f64, [f64; 6]) {
+    pub(super) fn weights(&self, rest: &RestTriangle, g: &[f64; 6]) -> (f64, [f64; 6]) {
         let c = rest.area * self.stiffness;
         let b = self.bending_scale;
         (
@@ -313,7 +313,7 @@ impl ElementModel {
     }
 
     /// Whether a hinge is folded beyond the barrier's threshold.
-    fn fold_active(&self, ch: &StrainChain) -> bool {
+    pub(super) fn fold_active(&self, ch: &StrainChain) -> bool {
         self.fold
             .is_some_and(|f| (0..3).any(|i| ch.hinge_angle(i).is_some_and(|t| t.abs() > f.angle)))
     }
@@ -405,18 +405,10 @@ impl ElementModel {
 /// A Cholesky attempt on the rows that are not identically zero first: when it succeeds the matrix is positive
 /// semi-definite and stays as it is, without the eigen-decomposition.
 fn project6(h: &mut [[f64; 6]; 6]) {
-    let sym = |i: usize, j: usize| 0.5 * (h[i][j] + h[j][i]);
-    let mut live = [0; 6];
-    let mut n = 0;
-    for i in 0..6 {
-        if (0..6).any(|j| h[i][j] != 0.0 || h[j][i] != 0.0) {
-            live[n] = i;
-            n += 1;
-        }
-    }
-    if cholesky_succeeds::<6>(sym, &live[..n], 0.0) {
+    if psd6_by_cholesky(h) {
         return;
     }
+    let sym = |i: usize, j: usize| 0.5 * (h[i][j] + h[j][i]);
     let m = SMatrix::<f64, 6, 6>::from_fn(sym);
     let eig = SymmetricEigen::new(m);
     if eig.eigenvalues.iter().all(|&l| l >= 0.0) {
@@ -465,6 +457,21 @@ pub fn project18(h: &mut [[f64; NDOF]; NDOF]) {
             }
         }
     }
+}
+
+/// Whether [`project6`]'s Cholesky test leaves the symmetric part of `h` as it is (the factorisation over the rows
+/// that are not identically zero succeeds).
+pub(super) fn psd6_by_cholesky(h: &[[f64; 6]; 6]) -> bool {
+    let sym = |i: usize, j: usize| 0.5 * (h[i][j] + h[j][i]);
+    let mut live = [0; 6];
+    let mut n = 0;
+    for i in 0..6 {
+        if (0..6).any(|j| h[i][j] != 0.0 || h[j][i] != 0.0) {
+            live[n] = i;
+            n += 1;
+        }
+    }
+    cholesky_succeeds::<6>(sym, &live[..n], 0.0)
 }
 
 /// Whether the Cholesky factorisation of m + shift·I restricted to the rows and columns `live` succeeds (every

@@ -14,6 +14,7 @@ pub mod strain;
 pub use strain::{strain, strain_reference, RestTriangle, StrainChain};
 pub mod arcsim;
 pub mod assemble;
+pub mod damping_lag;
 pub mod dissipation;
 pub mod element;
 pub mod fold;

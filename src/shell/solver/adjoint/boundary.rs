@@ -91,13 +91,15 @@ impl Simulation {
 
     /// dJ/dT of every held set and dJ/doᵢ of its keyframes (module documentation), from μ = λ − u and the
     /// observable's explicit ∂J/∂x over all dofs; `obs` `None` where J is not observed (a substep of a
-    /// trajectory), `inertia` the diagonal m (1/h² + c/h) / m of a dynamic substep's Hessian (0 when static).
+    /// trajectory), `inertia` the diagonal m (1/h² + c/h) / m of a dynamic substep's Hessian (0 when static),
+    /// `lag_mu` the lagged terms' Hessian times μ over all dofs where a substep has them (`lag`).
     pub(super) fn held_gradients(
         &self,
         obs: Option<&Observable>,
         mu: &[f64],
         djdx: &[f64],
         inertia: f64,
+        lag_mu: Option<&[f64]>,
     ) -> Result<Vec<HeldGradient>, ShellError> {
         let n = self.pattern.n;
         // dJ/dx_v for every held vertex (hard) or dJ/dp_v for every spring target
@@ -111,7 +113,7 @@ impl Simulation {
                     let m = inertia * self.mass[v];
                     for c in 0..3 {
                         let i = 3 * v + c;
-                        d[i] = djdx[i] - hmu[i] - m * mu[i];
+                        d[i] = djdx[i] - hmu[i] - m * mu[i] - lag_mu.map_or(0.0, |l| l[i]);
                     }
                 }
             }

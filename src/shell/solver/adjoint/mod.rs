@@ -42,6 +42,7 @@
 //! step): [`ShellError::AdjointUnsupported`] otherwise.
 
 mod boundary;
+mod lag;
 mod trajectory;
 
 use super::{obstacle, Simulation};
@@ -326,7 +327,7 @@ impl Simulation {
             mass_scale: 0.0,
             gravity: [0.0; 3],
             material: material.then(|| MaterialGradient::zeros(&self.model.material)),
-            held: self.held_gradients(Some(obs), &mu, &djdx, 0.0)?,
+            held: self.held_gradients(Some(obs), &mu, &djdx, 0.0, None)?,
             obstacles: self.obstacle_gradients(&mu),
         };
         let energy = matches!(obs, Observable::ElasticEnergy);

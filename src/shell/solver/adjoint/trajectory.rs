@@ -24,11 +24,11 @@
 //! dofs' −μ = u carries its ∂/∂x_k and ∂/∂v_k into x̄_k = μ m (1/h² + c/h) − v̄/h and v̄_k = μ m/h.
 //!
 //! Supported: implicit Euler (fixed or adaptive substeps: the recorded ones), elastic energy, gravity, linear
-//! drag, obstacle penalties, hard constraints and handle springs. Not: stiffness-proportional damping and air
-//! drag (their Hessians and faces are lagged at x_k and would need the energy's third derivatives), friction,
-//! BDF2 and the linearised scheme: [`ShellError::AdjointUnsupported`].
+//! drag, obstacle penalties, hard constraints, handle springs, and stiffness-proportional damping and air drag,
+//! whose data lagged at x_k add their own terms (`lag`). Not: friction, BDF2 and the linearised scheme, damping
+//! with the 18×18 projection: [`ShellError::AdjointUnsupported`].
 
-use super::{HeldGradient, Observable, Sensitivity, Simulation};
+use super::{Exact, HeldGradient, Observable, Sensitivity, Simulation};
 use crate::material::coefficients::MaterialGradient;
 use crate::shell::solver::Integrator;
 use crate::shell::ShellError;
@@ -94,10 +94,6 @@ impl Simulation {
             "the simulation is quasi-static (use the static sensitivity)"
         } else if s.integrator != Integrator::ImplicitEuler {
             "the trajectory adjoint follows implicit Euler substeps only"
-        } else if s.damping > 0.0 {
-            "stiffness-proportional damping lags the elastic Hessian at the step's start"
-        } else if !s.wind.is_off() {
-            "air drag lags its faces at the step's start"
         } else if s.friction > 0.0 {
             "friction lags the previous step's contacts"
         } else if self.tape.as_ref().is_none_or(|t| t.steps.is_empty()) {
@@ -126,6 +122,49 @@ impl Simulation {
         out
     }
 
+    /// Add substep k's inertia and linear drag to the exact system at its end state (the current one): their
+    /// gradient (a reaction includes them, and they are proportional to the masses) and their Hessian diagonal
+    /// m (1/h² + c/h); returns 1/h² + c/h.
+    fn add_inertia(&self, tape: &Tape, k: usize, ex: &mut Exact) -> f64 {
+        let n = self.pattern.n;
+        let c_drag = self.settings.drag;
+        let st = &tape.steps[k];
+        let h = st.h;
+        let xk = if k == 0 {
+            &tape.x0
+        } else {
+            &tape.steps[k - 1].x
+        };
+        let vk: Vec<f64> = if k == 0 {
+            tape.v0.clone()
+        } else {
+            let prev = if k == 1 {
+                &tape.x0
+            } else {
+                &tape.steps[k - 2].x
+            };
+            let hp = tape.steps[k - 1].h;
+            (0..3 * n).map(|i| (xk[i] - prev[i]) / hp).collect()
+        };
+        let inertia = 1.0 / (h * h) + c_drag / h;
+        for v in 0..n {
+            let m = self.mass[v];
+            for c in 0..3 {
+                let i = 3 * v + c;
+                let g = m * (st.x[i] - xk[i] - h * vk[i]) / (h * h)
+                    + c_drag * m * (st.x[i] - xk[i]) / h;
+                ex.g_mass[i] += g;
+                ex.g_full[i] += g;
+            }
+            if let Some(f) = self.pattern.free[v] {
+                let d = m * inertia;
+                let blk = std::array::from_fn(|r| std::array::from_fn(|s| d * f64::from(r == s)));
+                self.pattern.add_diag_block(&mut ex.values, f, &blk);
+            }
+        }
+        inertia
+    }
+
     fn reverse_pass(
         &mut self,
         tape: &Tape,
@@ -134,7 +173,6 @@ impl Simulation {
         material: bool,
     ) -> Result<Sensitivity, ShellError> {
         let n = self.pattern.n;
-        let c_drag = self.settings.drag;
         let mut out = Sensitivity {
             value: 0.0,
             residual: 0.0,
@@ -156,43 +194,27 @@ impl Simulation {
             } else {
                 &tape.steps[k - 1].x
             };
-            let vk: Vec<f64> = if k == 0 {
-                tape.v0.clone()
-            } else {
-                let prev = if k == 1 {
-                    &tape.x0
-                } else {
-                    &tape.steps[k - 2].x
-                };
-                let hp = tape.steps[k - 1].h;
-                (0..3 * n).map(|i| (xk[i] - prev[i]) / hp).collect()
-            };
             self.x.clone_from(&st.x);
             self.time = st.time;
             let mut ex = self.exact_system()?;
-            // the inertia and drag terms of Φ_k: their gradient (a reaction includes them, and they are
-            // proportional to the masses) and their Hessian diagonal m (1/h² + c/h)
-            let inertia = 1.0 / (h * h) + c_drag / h;
-            for v in 0..n {
-                let m = self.mass[v];
-                for c in 0..3 {
-                    let i = 3 * v + c;
-                    let g = m * (st.x[i] - xk[i] - h * vk[i]) / (h * h)
-                        + c_drag * m * (st.x[i] - xk[i]) / h;
-                    ex.g_mass[i] += g;
-                    ex.g_full[i] += g;
-                }
-                if let Some(f) = self.pattern.free[v] {
-                    let d = m * inertia;
-                    let blk =
-                        std::array::from_fn(|r| std::array::from_fn(|s| d * f64::from(r == s)));
-                    self.pattern.add_diag_block(&mut ex.values, f, &blk);
-                }
+            let inertia = self.add_inertia(tape, k, &mut ex);
+            let lag = self.lag_at(xk, h)?;
+            if let Some(lag) = &lag {
+                self.add_lag_terms(lag, xk, &mut ex);
             }
             let observed = at.contains(&k);
             let mut u = vec![0.0; 3 * n];
             if observed {
-                let (value, djdx, uo) = self.observable_parts(obs, &ex)?;
+                let (value, mut djdx, uo) = self.observable_parts(obs, &ex)?;
+                if let (Some(lag), true) = (&lag, uo.iter().any(|&a| a != 0.0)) {
+                    // a reaction's ∂R/∂x_f gains the lagged terms' free–held coupling
+                    let hu = self.lag_times(lag, &uo);
+                    for v in (0..n).filter(|&v| self.pattern.free[v].is_some()) {
+                        for c in 0..3 {
+                            djdx[3 * v + c] += hu[3 * v + c];
+                        }
+                    }
+                }
                 out.value += value;
                 for (a, b) in xbar.iter_mut().zip(&djdx) {
                     *a += b;
@@ -225,7 +247,11 @@ impl Simulation {
             }
             self.add_parameter_terms(&mu, &ex.g_mass, energy && observed, &mut out)?;
             let seen = observed.then_some(obs);
-            accumulate_held(&mut out.held, self.held_gradients(seen, &mu, &a, inertia)?);
+            let lag_mu = lag.as_ref().map(|l| self.lag_times(l, &mu));
+            accumulate_held(
+                &mut out.held,
+                self.held_gradients(seen, &mu, &a, inertia, lag_mu.as_deref())?,
+            );
             for (t, g) in out.obstacles.iter_mut().zip(self.obstacle_gradients(&mu)) {
                 for c in 0..3 {
                     t[c] += g[c];
@@ -239,6 +265,9 @@ impl Simulation {
                     xbar[i] = mu[i] * m * inertia - vbar[i] / h;
                     vbar[i] = mu[i] * m / h;
                 }
+            }
+            if let Some(lag) = &lag {
+                self.lag_adjoint(lag, xk, &mu, &mut out, &mut xbar)?;
             }
         }
         Ok(out)
