@@ -28,14 +28,18 @@ pub use crate::strain::{Strain6, StrainComponent};
 /// A 1D term f_k of the material: k is its strain (the file's index k = 0…4: s_x, s_a, s_y, Π₀₀, Π₁₁).
 #[derive(Clone, Debug)]
 pub struct Term1D {
+    /// the strain component k
     pub strain: StrainComponent,
+    /// the spline f_k of z_k/σ_k (J/m²)
     pub spline: Hermite1D,
 }
 
 /// A 2D term f_kl of the material: strains (k, l), k in-plane, l after k.
 #[derive(Clone, Debug)]
 pub struct Term2D {
+    /// the strain components (k, l)
     pub strains: [StrainComponent; 2],
+    /// the spline f_kl of (z_k/σ_k, z_l/σ_l) (J/m²)
     pub spline: Hermite2D,
 }
 
@@ -48,7 +52,9 @@ pub struct Material {
     pub strain_scale: [f64; 5],
     /// C₀
     pub constant: f64,
+    /// the 1D terms f_k
     pub terms1d: Vec<Term1D>,
+    /// the 2D terms f_kl
     pub terms2d: Vec<Term2D>,
     /// top-level keys other than density, strain scale and coeffs (e.g. "strain shift", "meta"), in file order
     pub extra: serde_json::Map<String, serde_json::Value>,
@@ -65,16 +71,27 @@ pub const MAX_NORMALISED_STRAIN: f64 = 1e3;
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MaterialStrainError {
     #[error("{component} = {} is not finite", compact(*value))]
-    NotFinite { component: &'static str, value: f64 },
+    /// A strain component that is NaN or infinite.
+    NotFinite {
+        /// the component's name
+        component: &'static str,
+        /// its value
+        value: f64,
+    },
     #[error(
         "{component} = {} is outside the material's admissible range |{component}| ≤ {limit:e} \
          ({MAX_NORMALISED_STRAIN:e} strain scales σ = {scale})",
         compact(*value)
     )]
+    /// A strain component beyond [`MAX_NORMALISED_STRAIN`] strain scales.
     OutOfRange {
+        /// the component's name
         component: &'static str,
+        /// its value
         value: f64,
+        /// the largest admissible |z_k| (MAX_NORMALISED_STRAIN · σ_k)
         limit: f64,
+        /// the strain scale σ_k
         scale: f64,
     },
 }
@@ -82,8 +99,11 @@ pub enum MaterialStrainError {
 /// ψ, ∇ψ and ∇²ψ at one strain.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PsiVgh {
+    /// ψ(z) (J/m²)
     pub value: f64,
+    /// ∇ψ = ∂ψ/∂z (J/m² per unit strain; J/m per 1/m for the II components)
     pub grad: [f64; 6],
+    /// ∇²ψ = ∂²ψ/∂z² (symmetric)
     pub hess: [[f64; 6]; 6],
 }
 

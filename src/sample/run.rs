@@ -76,6 +76,7 @@ pub struct RunSummary {
     /// Finished records of the selected chains that lacked sensitivities, and of these the ones given them (the
     /// others were re-solved to another result, or their sensitivities could not be computed).
     pub lacking_sensitivities: usize,
+    /// Of `lacking_sensitivities`, the records given them.
     pub sensitivities_added: usize,
     /// Wall time (s).
     pub time: f64,
