@@ -728,6 +728,56 @@ fn meta_block(
 /// Fit a material (Algorithm C5) to the records of `plan` (other records are ignored; a record whose id does not
 /// carry the plan's hash is an error, as is a plan without 1D ranges). `density` is ρ_A (kg/m²); `meta` goes into
 /// the material's `meta` block, completed with the plan hash, the options and the fit errors.
+///
+/// # Example
+///
+/// Synthetic records whose Ψ̄ and stresses are the default material's ψ and ∇ψ on a plan of 1D ranges only (15
+/// samples each): the fit gives back that material along each range to a few percent.
+///
+/// ```
+/// use hylc::fit::model::strain6;
+/// use hylc::fit::{fit_material, FitOptions};
+/// use hylc::material::synthetic::default_material;
+/// use hylc::sample::{Plan, Record, SampleStart, SampleStatus};
+///
+/// let truth = default_material();
+/// let plan = Plan { count_1d: 15, count_2d: 0, pairs: vec![], ..Plan::default() };
+/// let records: Vec<Record> = plan
+///     .samples()
+///     .into_iter()
+///     .map(|s| {
+///         let e = truth.eval(&strain6(&s.z));
+///         let g = e.grad;
+///         Record {
+///             id: s.id,
+///             index: s.index,
+///             z: s.z,
+///             psi: Some(e.value),
+///             stress: Some([Some(g[0]), Some(g[1]), Some(g[2]), Some(g[3]), Some(g[5])]),
+///             status: SampleStatus::Converged,
+///             error: None,
+///             steps: 1,
+///             gradient_norm: Some(0.0),
+///             time: 0.0,
+///             start: SampleStart::Cold,
+///             problem: "0000000000000000".into(),
+///             starts: vec![],
+///             kept: None,
+///             crossings: None,
+///             dpsi_dtheta: None,
+///             dstress_dtheta: None,
+///         }
+///     })
+///     .collect();
+///
+/// let fit = fit_material(&plan, &records, 0.25, Default::default(), &FitOptions::covering())?;
+/// assert_eq!(fit.report.converged, plan.len());
+/// assert_eq!(fit.material.terms1d.len(), 5);
+/// for t in &fit.report.terms1d {
+///     assert!(t.model.rms_rel < 0.05, "{:?}: {}", t.strain, t.model.rms_rel);
+/// }
+/// # Ok::<(), hylc::fit::FitError>(())
+/// ```
 pub fn fit_material(
     plan: &Plan,
     records: &[Record],

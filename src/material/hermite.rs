@@ -96,7 +96,7 @@ pub struct BasisPiece {
     pub origin: f64,
     /// length h of the cell (of the end cell on an exterior piece)
     pub h: f64,
-    /// power-basis coefficients: weight b = Σ_j w[b][j] sʲ
+    /// power-basis coefficients: weight b is `Σ_j w[b][j] sʲ`
     pub w: [[f64; 4]; 4],
 }
 

@@ -414,6 +414,35 @@ impl MicroProblem {
     }
 
     /// Solve at `strain`, starting from `start` (the reference state when `None`).
+    ///
+    /// # Example
+    ///
+    /// A cold solve of the generated plain weave (used as generated; `hylc run` first brings a pattern to its
+    /// reference state, [`super::reference`]) at 5 % stretch along ξ₁, then a warm one next to it: the
+    /// envelope-theorem stress σ_x = ∂Ψ̄/∂s_x matches the central difference of Ψ̄.
+    ///
+    /// ```
+    /// use hylc::generate::default_pattern;
+    /// use hylc::micro::envelope::energy_strain_gradient;
+    /// use hylc::micro::{MacroStrain, MicroProblem, SolverOptions, Status};
+    /// use hylc::rod::YarnMaterial;
+    ///
+    /// let pattern = default_pattern("plain")?;
+    /// let problem = MicroProblem::new(pattern, &YarnMaterial::default(), SolverOptions::default());
+    /// let at = |s_x: f64| MacroStrain::new(s_x, 0.0, 0.0, 0.0, 0.0);
+    /// let mid = problem.solve(&at(0.05), None)?;
+    /// assert_eq!(mid.status, Status::Converged);
+    /// let psi = mid.psi()?; // Ψ̄ = E / (p₁ p₂), J/m²
+    /// assert!(psi > 0.0);
+    ///
+    /// let h = 1e-4;
+    /// let plus = problem.solve(&at(0.05 + h), Some(&mid.state))?.psi()?;
+    /// let minus = problem.solve(&at(0.05 - h), Some(&mid.state))?.psi()?;
+    /// let sigma_x = energy_strain_gradient(&problem, &mid.state)?[0].unwrap() / mid.area;
+    /// let fd = (plus - minus) / (2.0 * h);
+    /// assert!((sigma_x - fd).abs() <= 1e-3 * sigma_x.abs(), "{sigma_x} vs {fd}");
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn solve(
         &self,
         strain: &MacroStrain,
