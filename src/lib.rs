@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! hylc — homogenized yarn-level cloth.
 //!
 //! Stages follow the data flow of `docs/layout.md`. Layers import downwards only (a test,

@@ -19,7 +19,10 @@ pub enum PeriodicError {
     Invalid(String),
     /// The list lacks the image with this periodic offset.
     #[error("contact broad phase: no tile image with offset ({}, {})", offset[0], offset[1])]
-    MissingImage { offset: Offset },
+    MissingImage {
+        /// the offset asked for
+        offset: Offset,
+    },
 }
 
 /// Negated offset.
@@ -36,13 +39,16 @@ pub fn is_positive(o: Offset) -> bool {
 /// and `rotation(o)` is the (constant) rotation part of that map, applied to directors and used to pull
 /// gradients back to the home dofs.
 pub trait Placement: Sync {
+    /// The copy at offset `offset` of the home-tile point `x` (m).
     fn position(&self, x: &Vector3<f64>, offset: [i32; 2]) -> Vector3<f64>;
+    /// The rotation part of the map to offset `offset`.
     fn rotation(&self, offset: [i32; 2]) -> Matrix3<f64>;
 }
 
 /// Copies as translations by (o₁p₁, o₂p₂, 0): the tile at zero macro strain.
 #[derive(Clone, Copy, Debug)]
 pub struct Translation {
+    /// the periods (p₁, p₂) (m)
     pub periods: [f64; 2],
 }
 
@@ -239,18 +245,22 @@ impl TileImages {
         TileImages { images: v }
     }
 
+    /// Number of images (the home included).
     pub fn len(&self) -> usize {
         self.images.len()
     }
 
+    /// Whether there is no image.
     pub fn is_empty(&self) -> bool {
         self.images.is_empty()
     }
 
+    /// Image number `k`.
     pub fn get(&self, k: usize) -> &TileImage {
         &self.images[k]
     }
 
+    /// The images in order (the home first).
     pub fn iter(&self) -> std::slice::Iter<'_, TileImage> {
         self.images.iter()
     }

@@ -13,7 +13,9 @@ pub const COMMIT: &str = env!("HYLC_COMMIT");
 /// The provenance record of an output.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct Provenance {
+    /// hylc's version ([`VERSION`])
     pub hylc: &'static str,
+    /// the commit hylc was built from ([`COMMIT`])
     pub commit: &'static str,
     /// the process's command line (for the Python module: the interpreter's)
     pub command: Vec<String>,

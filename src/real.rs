@@ -14,16 +14,20 @@ pub fn c<D: Real>(x: f64) -> D {
     D::from(x)
 }
 
+/// A 3-vector of a generic scalar.
 pub type V3<D> = [D; 3];
 
+/// The first three entries of `x`.
 pub fn v3<D: Real>(x: &[D]) -> V3<D> {
     [x[0].clone(), x[1].clone(), x[2].clone()]
 }
 
+/// A 3-vector of constants.
 pub fn from_f64<D: Real>(x: &nalgebra::Vector3<f64>) -> V3<D> {
     [D::from(x[0]), D::from(x[1]), D::from(x[2])]
 }
 
+/// a + b.
 pub fn add<D: Real>(a: &V3<D>, b: &V3<D>) -> V3<D> {
     [
         a[0].clone() + b[0].clone(),
@@ -32,6 +36,7 @@ pub fn add<D: Real>(a: &V3<D>, b: &V3<D>) -> V3<D> {
     ]
 }
 
+/// a − b.
 pub fn sub<D: Real>(a: &V3<D>, b: &V3<D>) -> V3<D> {
     [
         a[0].clone() - b[0].clone(),
@@ -40,6 +45,7 @@ pub fn sub<D: Real>(a: &V3<D>, b: &V3<D>) -> V3<D> {
     ]
 }
 
+/// s a.
 pub fn scale<D: Real>(a: &V3<D>, s: &D) -> V3<D> {
     [
         a[0].clone() * s.clone(),
@@ -48,10 +54,12 @@ pub fn scale<D: Real>(a: &V3<D>, s: &D) -> V3<D> {
     ]
 }
 
+/// a · b.
 pub fn dot<D: Real>(a: &V3<D>, b: &V3<D>) -> D {
     a[0].clone() * b[0].clone() + a[1].clone() * b[1].clone() + a[2].clone() * b[2].clone()
 }
 
+/// a × b.
 pub fn cross<D: Real>(a: &V3<D>, b: &V3<D>) -> V3<D> {
     [
         a[1].clone() * b[2].clone() - a[2].clone() * b[1].clone(),
@@ -60,6 +68,7 @@ pub fn cross<D: Real>(a: &V3<D>, b: &V3<D>) -> V3<D> {
     ]
 }
 
+/// |a| = √(a · a).
 pub fn norm<D: Real>(a: &V3<D>) -> D {
     dot(a, a).sqrt()
 }

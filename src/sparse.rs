@@ -13,7 +13,9 @@ use faer::sparse::SymbolicSparseColMatRef;
 pub struct LowerPattern {
     /// Order of the matrix.
     pub n: usize,
+    /// Column starts: column j's entries are at `col_ptr[j]..col_ptr[j + 1]` (n + 1 entries).
     pub col_ptr: Vec<usize>,
+    /// Row index of each stored entry.
     pub row_idx: Vec<usize>,
     /// Value slot of each diagonal entry.
     pub diag: Vec<usize>,

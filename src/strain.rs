@@ -25,14 +25,19 @@ pub fn compact(x: f64) -> String {
 /// (and parsed) by its name: `s_x`, `s_a`, `s_y`, `II00`, `II11`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub enum StrainComponent {
+    /// s_x: the stretch along ξ₁.
     #[serde(rename = "s_x")]
     Sx,
+    /// s_a: the cosine of the angle between the stretched material axes.
     #[serde(rename = "s_a")]
     Sa,
+    /// s_y: the stretch along ξ₂.
     #[serde(rename = "s_y")]
     Sy,
+    /// Π₀₀ (II₀₀): the curvature of bending along ξ₁ (1/m).
     #[serde(rename = "II00")]
     II00,
+    /// Π₁₁ (II₁₁): the curvature of bending along ξ₂ (1/m).
     #[serde(rename = "II11")]
     II11,
 }
@@ -84,6 +89,7 @@ impl fmt::Display for StrainComponent {
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[error("unknown strain {name:?} (expected one of s_x, s_a, s_y, II00, II11)")]
 pub struct UnknownStrain {
+    /// the name given
     pub name: String,
 }
 
@@ -105,12 +111,25 @@ pub struct Strain6(pub [f64; 6]);
 /// Why a text is not a [`Strain6`].
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum Strain6Error {
+    /// The text does not have 6 numbers (the count found).
     #[error("expected 6 numbers (s_x, s_a, s_y, II00, II01, II11), found {0}")]
     Count(usize),
     #[error("{name} = {text:?} is not a number")]
-    NotANumber { name: &'static str, text: String },
+    /// A component that is not a number.
+    NotANumber {
+        /// the component's name
+        name: &'static str,
+        /// its text
+        text: String,
+    },
     #[error("{name} = {text} is not finite")]
-    NotFinite { name: &'static str, text: String },
+    /// A component that is not finite.
+    NotFinite {
+        /// the component's name
+        name: &'static str,
+        /// its text
+        text: String,
+    },
 }
 
 impl Strain6 {

@@ -21,8 +21,11 @@ use rand_chacha::ChaCha8Rng;
 
 /// The pair energy with fixed k_c, r, Q and rest lengths under the harness.
 pub struct PairCheck {
+    /// the check's name
     pub name: String,
+    /// the pair kernel (k_c, r, Q)
     pub kernel: PairKernel,
+    /// rest lengths of the two segments (m)
     pub rest: [f64; 2],
 }
 
@@ -109,10 +112,15 @@ impl Differentiable for PairCheck {
 /// as a dual number. Scales as [`PairCheck`] (r is a length like the coordinates, so ∂E/∂r ~ V/r and the mixed
 /// and second radius derivatives ~ V/r²); samples are [`sample_pair`]'s at r = 1 mm, the radius input at r.
 pub struct PairRadiusCheck {
+    /// the check's name
     pub name: String,
+    /// contact stiffness k_c (J/m²)
     pub stiffness: f64,
+    /// the radius r at which the samples are made (m)
     pub radius: f64,
+    /// Gauss–Legendre order Q
     pub order: usize,
+    /// rest lengths of the two segments (m)
     pub rest: [f64; 2],
 }
 

@@ -164,7 +164,9 @@ impl Differentiable for Spline2DCheck {
 
 /// ψ (or a single term of it, as a material holding only that term) under the harness.
 pub struct PsiCheck {
+    /// the check's name
     pub name: String,
+    /// the material (or a material holding only the checked term)
     pub material: Material,
 }
 

@@ -38,6 +38,7 @@ pub struct StrainCase {
 }
 
 impl StrainCase {
+    /// The case of `pattern` with `material` at `strain`: the equilibrium there, its kinematics and contact pairs.
     pub fn new(pattern: Pattern, material: &YarnMaterial, strain: MacroStrain) -> Self {
         let problem = MicroProblem::new(pattern, material, SolverOptions::default());
         let mut state = problem.reference_state();

@@ -312,7 +312,9 @@ fn material_magnitudes(m: &Material) -> (f64, f64, f64) {
 
 /// The triangle energy A·k·ψ(S z(q)).
 pub struct TriangleCheck {
+    /// the check's name
     pub name: String,
+    /// the element model (material, multipliers)
     pub model: ElementModel,
 }
 
@@ -469,9 +471,13 @@ impl Differentiable for TriangleCheck {
 
 /// The assembled elastic energy of a small perturbed mesh (all vertices free).
 pub struct MeshCheck {
+    /// the element model
     pub model: ElementModel,
+    /// the mesh's stencils
     pub stencils: Vec<Stencil>,
+    /// the rest layout of the vertices (m)
     pub rest: Vec<[f64; 2]>,
+    /// the Hessian's sparsity pattern
     pub pattern: Pattern,
 }
 

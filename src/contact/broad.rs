@@ -136,6 +136,7 @@ impl SegmentTopology {
         self.yarn.len()
     }
 
+    /// Whether there is no segment.
     pub fn is_empty(&self) -> bool {
         self.yarn.is_empty()
     }
@@ -198,8 +199,11 @@ impl SegmentTopology {
 /// [`TileImages`]). Canonical: image 0 (home) with a < b, or an image with a positive offset.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct CandidatePair {
+    /// the home segment (index of its start vertex)
     pub a: usize,
+    /// the other segment, before the image's map
     pub b: usize,
+    /// the tile image of `b` (index into the [`TileImages`])
     pub image: usize,
 }
 
@@ -347,18 +351,22 @@ impl BroadPhase {
         &self.segments
     }
 
+    /// The tile images.
     pub fn images(&self) -> &TileImages {
         &self.images
     }
 
+    /// The segments' topology.
     pub fn topology(&self) -> &SegmentTopology {
         &self.topology
     }
 
+    /// The yarn radius r (m).
     pub fn radius(&self) -> f64 {
         self.radius
     }
 
+    /// The broad-phase margin (m): pairs closer than 2r + margin are candidates.
     pub fn margin(&self) -> f64 {
         self.margin
     }

@@ -27,10 +27,15 @@ use nalgebra::Vector3;
 /// t ∈ [0, 1] and the direction (±1, the sign of df/dt).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Crossing {
+    /// the home segment
     pub a: usize,
+    /// the other segment
     pub b: usize,
+    /// the periodic offset of `b`'s image
     pub offset: [i32; 2],
+    /// when along the step, t ∈ [0, 1]
     pub time: f64,
+    /// the direction, ±1 (the sign of df/dt)
     pub sign: i8,
 }
 

@@ -37,7 +37,14 @@ pub enum ContactError {
         "contact overlap: quadrature points {p} and {q} at normalised distance rho = {rho:.3e} (below {min:.0e})",
         min = RHO_MIN
     )]
-    Overlap { rho: f64, p: usize, q: usize },
+    Overlap {
+        /// the normalised distance ρ = |x_p − x_q|/(2r)
+        rho: f64,
+        /// node on segment a
+        p: usize,
+        /// node on segment b
+        q: usize,
+    },
     /// An input coordinate is NaN.
     #[error("contact: non-finite input coordinate")]
     NonFinite,
@@ -46,7 +53,10 @@ pub enum ContactError {
     InvalidParameter(String),
     /// The broad phase needs the tile image with this periodic offset and was not given it.
     #[error("contact broad phase: no tile image with offset ({}, {})", .offset[0], .offset[1])]
-    MissingImage { offset: [i32; 2] },
+    MissingImage {
+        /// the missing image's offset
+        offset: [i32; 2],
+    },
 }
 
 impl From<crate::periodic::PeriodicError> for ContactError {

@@ -38,8 +38,11 @@ const REJECT_SAFETY: f64 = 1e-8;
 /// Value, gradient (12) and Hessian (12×12) of one pair energy; coordinate order (x_a0, x_a1, x_b0, x_b1).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PairVgh {
+    /// the energy (J)
     pub value: f64,
+    /// its gradient (N)
     pub gradient: SVector<f64, 12>,
+    /// its Hessian (N/m)
     pub hessian: SMatrix<f64, 12, 12>,
 }
 
@@ -130,14 +133,17 @@ impl PairKernel {
         Self::new(m.contact_stiffness, m.radius, m.contact_quadrature)
     }
 
+    /// The contact stiffness k_c (J/m²).
     pub fn stiffness(&self) -> f64 {
         self.stiffness
     }
 
+    /// The yarn radius r (m).
     pub fn radius(&self) -> f64 {
         self.radius
     }
 
+    /// The Gauss–Legendre rule (Q points).
     pub fn rule(&self) -> &GaussLegendre {
         &self.rule
     }

@@ -55,8 +55,11 @@ pub const POLICY: Tolerances = Tolerances {
 /// `‖a − b‖ ≤ tol · (‖b‖ + scale)`. Each implementation documents its choice.
 #[derive(Clone, Copy, Debug)]
 pub struct Scales {
+    /// magnitude added to |b| in the value test
     pub value: f64,
+    /// magnitude added to ‖b‖ in the gradient tests
     pub gradient: f64,
+    /// magnitude added to ‖b‖ in the Hessian tests
     pub hessian: f64,
 }
 
@@ -73,8 +76,11 @@ impl Default for Scales {
 /// Value, gradient and Hessian of a scalar function (the output of every fast implementation).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Vgh {
+    /// the value f(x)
     pub value: f64,
+    /// the gradient ∇f(x)
     pub gradient: DVector<f64>,
+    /// the Hessian ∇²f(x)
     pub hessian: DMatrix<f64>,
 }
 
@@ -142,8 +148,11 @@ pub trait Differentiable: Sync {
 /// Settings of one harness run.
 #[derive(Clone, Copy, Debug)]
 pub struct CheckConfig {
+    /// random input cases per function
     pub cases: usize,
+    /// seed of the random inputs
     pub seed: u64,
+    /// the tolerances (default [`POLICY`])
     pub tolerances: Tolerances,
     /// Finite-difference step relative to the input scale (before Richardson halving).
     pub fd_step: f64,
@@ -165,7 +174,9 @@ impl Default for CheckConfig {
 
 /// Object-safe view of a [`Differentiable`]: what the registry stores.
 pub trait Check: Sync {
+    /// The function's name in reports.
     fn name(&self) -> String;
+    /// Run the harness on the function ([`check_function`]).
     fn check(&self, cfg: &CheckConfig) -> Report;
 }
 
@@ -217,10 +228,15 @@ pub fn reference_ad<F: Differentiable + ?Sized>(f: &F, x: &[f64]) -> Vgh {
 /// Errors of one input case (relative normwise, see [`rel_err`]); `None` when a check was skipped.
 #[derive(Clone, Debug)]
 pub struct CaseErrors {
+    /// fast value against the reference value in f64
     pub value: f64,
+    /// fast gradient against the num-dual gradient of the reference
     pub gradient_ad: f64,
+    /// fast Hessian against the num-dual Hessian of the reference
     pub hessian_ad: f64,
+    /// fast gradient against finite differences (`None`: skipped)
     pub gradient_fd: Option<f64>,
+    /// fast Hessian against finite differences (`None`: skipped)
     pub hessian_fd: Option<f64>,
 }
 

@@ -5,22 +5,32 @@ use super::{CaseErrors, Tolerances};
 /// Summary of one function's check.
 #[derive(Clone, Debug)]
 pub struct Report {
+    /// the function's name
     pub name: String,
+    /// input cases checked
     pub cases: usize,
     /// cases where the finite-difference comparison was skipped (too close to a kink)
     pub fd_skipped: usize,
+    /// largest value error (relative normwise)
     pub max_value: f64,
+    /// largest gradient error against AD
     pub max_gradient_ad: f64,
+    /// largest Hessian error against AD
     pub max_hessian_ad: f64,
+    /// largest gradient error against finite differences
     pub max_gradient_fd: f64,
+    /// largest Hessian error against finite differences
     pub max_hessian_fd: f64,
     /// largest error-to-tolerance ratio over all checks and cases (≤ 1 passes)
     pub worst_ratio: f64,
+    /// the input of the worst ratio
     pub worst_input: Vec<f64>,
+    /// cases with a ratio > 1
     pub failures: usize,
 }
 
 impl Report {
+    /// The summary of the errors of `cases` (input, errors) against the tolerances `tol`.
     pub fn from_cases(name: String, cases: &[(Vec<f64>, CaseErrors)], tol: &Tolerances) -> Report {
         let mut r = Report {
             name,
@@ -61,6 +71,7 @@ impl Report {
         r
     }
 
+    /// Whether every case passed (and there was at least one).
     pub fn passed(&self) -> bool {
         self.failures == 0 && self.cases > 0
     }

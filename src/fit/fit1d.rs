@@ -106,8 +106,11 @@ pub struct Fit1DReport {
 /// A fitted 1D term: the residual spline (value 0 at x = 0), the constant removed in step 6, and the report.
 #[derive(Clone, Debug)]
 pub struct Fit1D {
+    /// the residual spline (value 0 at x = 0)
     pub spline: Hermite1D,
+    /// the constant removed in step 6 (J/m²; it belongs to f₀)
     pub offset: f64,
+    /// the fit's report
     pub report: Fit1DReport,
     /// the smoothed curve g of step 1 at 201 points over the samples' range (for plots)
     pub curve: Vec<[f64; 2]>,

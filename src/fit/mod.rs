@@ -32,10 +32,20 @@ pub use tangent::{fit_material_tangent, fit_material_tangents, RecordTangent};
 pub enum FitError {
     /// X and Ψ have different lengths
     #[error("sample arrays differ in length: {x} abscissae, {psi} values")]
-    LengthMismatch { x: usize, psi: usize },
+    LengthMismatch {
+        /// abscissae given
+        x: usize,
+        /// values given
+        psi: usize,
+    },
     /// fewer usable (finite) samples or distinct abscissae than the method needs
     #[error("too few usable samples: {usable} (need at least {needed} distinct finite ones)")]
-    TooFewSamples { usable: usize, needed: usize },
+    TooFewSamples {
+        /// usable samples found
+        usable: usize,
+        /// the fewest the method needs
+        needed: usize,
+    },
     /// an option outside its valid range
     #[error("invalid fit option: {0}")]
     BadOption(String),
@@ -44,7 +54,12 @@ pub enum FitError {
     Knots(String),
     /// one term of a whole-material fit failed (`term` names it: `1D term 0 (s_x)`, `2D term (s_x, s_a)`)
     #[error("{term}: {source}")]
-    Term { term: String, source: Box<FitError> },
+    Term {
+        /// the term's name
+        term: String,
+        /// its error
+        source: Box<FitError>,
+    },
     /// the fitted model came out with a non-finite number (named), so no material is written
     #[error("the fit did not converge: {0} is not finite")]
     NotFinite(String),
@@ -55,8 +70,11 @@ pub enum FitError {
     /// a sample record that cannot be fitted: its id, the field and what is wrong
     #[error("sample {id}: {field}: {message}")]
     BadRecord {
+        /// the sample's id
         id: String,
+        /// the field at fault
         field: String,
+        /// what is wrong
         message: String,
     },
 }

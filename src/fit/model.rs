@@ -159,16 +159,21 @@ impl ModelError {
 /// One 1D term's report.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Term1DReport {
+    /// index k of the strain in z = (s_x, s_a, s_y, Π₀₀, Π₁₁)
     pub k: usize,
+    /// the strain component of the term
     pub strain: StrainComponent,
     /// samples used / excluded (failed)
     pub n_samples: usize,
+    /// samples of the range excluded (failed, no Ψ̄)
     pub n_excluded: usize,
     /// FIT1D's own fit (spline + its offset against Ψ̄)
     pub fit_rms_rel: f64,
+    /// FIT1D's largest error relative to max |Ψ̄|
     pub fit_max_rel: f64,
     /// the removed constant (Ψ̄ at the minimum knot)
     pub offset: f64,
+    /// index of the minimum knot (the knot at 0, or argmin p for bending)
     pub i_min: usize,
     /// the whole model ψ on this range
     pub model: ModelError,
@@ -181,16 +186,25 @@ fn is_zero(n: &usize) -> bool {
 /// One 2D term's report.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Term2DReport {
+    /// index k of the first strain (k < l)
     pub k0: usize,
+    /// index l of the second strain
     pub k1: usize,
+    /// the two strain components of the term
     pub strains: [StrainComponent; 2],
+    /// samples of the plane used
     pub n_samples: usize,
+    /// samples of the plane excluded (failed, no Ψ̄)
     pub n_excluded: usize,
     /// FIT2D's unconverted spline against Ψ̄
     pub fit_rms_rel: f64,
+    /// FIT2D's largest error relative to max |Ψ̄|
     pub fit_max_rel: f64,
+    /// rounds of twist halving that FIT2D step 5 needed
     pub twist_rounds: usize,
+    /// rounds of cross-slope shrinking that FIT2D step 5 needed after the twists
     pub slope_rounds: usize,
+    /// patches still failing the monotonicity check of FIT2D step 5
     pub nonmonotone_patches: usize,
     /// patches of the compressed block failing FIT2D step 7′ (only with `compression_residual`)
     #[serde(skip_serializing_if = "is_zero")]
@@ -202,20 +216,27 @@ pub struct Term2DReport {
 /// The fit report (written as JSON next to the material).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct FitReport {
+    /// the hash of the plan the samples were drawn from
     pub plan_hash: String,
     /// samples of the plan found in the file / converged among them
     pub samples: usize,
+    /// converged samples of the plan (those with a Ψ̄)
     pub converged: usize,
+    /// the strain scales σ_k = max |z_k| over the plan's samples (1 where the plan never varies z_k)
     pub strain_scale: [f64; 5],
+    /// the constant f₀ (J/m²): Ψ̄ of the converged sample nearest z = 0
     pub constant: f64,
     /// the sample f₀ was taken from
     pub constant_at: [f64; 5],
     /// max |offset − f₀| over the three in-plane 1D fits (their MLS estimates of Ψ̄(0))
     pub constant_spread: f64,
+    /// the 1D terms' reports, in the material's order
     pub terms1d: Vec<Term1DReport>,
+    /// the 2D terms' reports, in the material's order
     pub terms2d: Vec<Term2DReport>,
     /// the model on every sample it was fitted to
     pub all: ModelError,
+    /// the model on the held-out samples, when a held-out file was given
     pub holdout: Option<ModelError>,
     /// the 1D curves against another material ([`compare_1d`]), when asked for
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -225,17 +246,24 @@ pub struct FitReport {
 /// The data one term was fitted to (for plots): normalised coordinates and Ψ̄ (NaN for failed samples).
 #[derive(Clone, Debug)]
 pub struct TermData {
+    /// normalised coordinate z_k/σ_k of each sample (the first axis of a 2D term)
     pub x: Vec<f64>,
+    /// normalised coordinate z_l/σ_l of each sample (empty for a 1D term)
     pub y: Vec<f64>,
+    /// Ψ̄ of each sample (J/m²; NaN for failed samples)
     pub psi: Vec<f64>,
 }
 
 /// A fitted material with its report and the per-term fits and data.
 #[derive(Clone, Debug)]
 pub struct MaterialFit {
+    /// the fitted material ψ(z)
     pub material: Material,
+    /// the fit report
     pub report: FitReport,
+    /// the 1D fits: (strain index k, FIT1D result, its data)
     pub fits1d: Vec<(usize, Fit1D, TermData)>,
+    /// the 2D fits: (strain indices k, l, FIT2D result, its data)
     pub fits2d: Vec<(usize, usize, Fit2D, TermData)>,
 }
 
@@ -700,6 +728,56 @@ fn meta_block(
 /// Fit a material (Algorithm C5) to the records of `plan` (other records are ignored; a record whose id does not
 /// carry the plan's hash is an error, as is a plan without 1D ranges). `density` is ρ_A (kg/m²); `meta` goes into
 /// the material's `meta` block, completed with the plan hash, the options and the fit errors.
+///
+/// # Example
+///
+/// Synthetic records whose Ψ̄ and stresses are the default material's ψ and ∇ψ on a plan of 1D ranges only (15
+/// samples each): the fit gives back that material along each range to a few percent.
+///
+/// ```
+/// use hylc::fit::model::strain6;
+/// use hylc::fit::{fit_material, FitOptions};
+/// use hylc::material::synthetic::default_material;
+/// use hylc::sample::{Plan, Record, SampleStart, SampleStatus};
+///
+/// let truth = default_material();
+/// let plan = Plan { count_1d: 15, count_2d: 0, pairs: vec![], ..Plan::default() };
+/// let records: Vec<Record> = plan
+///     .samples()
+///     .into_iter()
+///     .map(|s| {
+///         let e = truth.eval(&strain6(&s.z));
+///         let g = e.grad;
+///         Record {
+///             id: s.id,
+///             index: s.index,
+///             z: s.z,
+///             psi: Some(e.value),
+///             stress: Some([Some(g[0]), Some(g[1]), Some(g[2]), Some(g[3]), Some(g[5])]),
+///             status: SampleStatus::Converged,
+///             error: None,
+///             steps: 1,
+///             gradient_norm: Some(0.0),
+///             time: 0.0,
+///             start: SampleStart::Cold,
+///             problem: "0000000000000000".into(),
+///             starts: vec![],
+///             kept: None,
+///             crossings: None,
+///             dpsi_dtheta: None,
+///             dstress_dtheta: None,
+///         }
+///     })
+///     .collect();
+///
+/// let fit = fit_material(&plan, &records, 0.25, Default::default(), &FitOptions::covering())?;
+/// assert_eq!(fit.report.converged, plan.len());
+/// assert_eq!(fit.material.terms1d.len(), 5);
+/// for t in &fit.report.terms1d {
+///     assert!(t.model.rms_rel < 0.05, "{:?}: {}", t.strain, t.model.rms_rel);
+/// }
+/// # Ok::<(), hylc::fit::FitError>(())
+/// ```
 pub fn fit_material(
     plan: &Plan,
     records: &[Record],
@@ -777,7 +855,9 @@ pub fn fit_material(
 /// One 1D range compared with another material (validation item 3d).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RangeComparison {
+    /// index k of the strain in z
     pub k: usize,
+    /// the strain component
     pub strain: StrainComponent,
     /// points compared (the plan's values of the range inside the other material's sampled range)
     pub n_points: usize,
@@ -801,6 +881,7 @@ pub struct RangeComparison {
 /// The 1D comparison of two materials.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Comparison1D {
+    /// the compared 1D ranges, one per strain the plan varies
     pub ranges: Vec<RangeComparison>,
     /// One factor c for all ranges, minimising Σ_k ‖c ours_k − theirs_k‖² / ‖theirs_k‖². Ψ̄ is exactly
     /// proportional to a common factor on all yarn stiffnesses (Y, G, k_c: the equilibria do not change), so c

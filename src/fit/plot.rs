@@ -30,7 +30,9 @@ pub enum PlotErrorKind {
 #[derive(Debug, thiserror::Error)]
 #[error("{}: {kind}", path.display())]
 pub struct PlotError {
+    /// the file (or folder)
     pub path: PathBuf,
+    /// what went wrong
     pub kind: PlotErrorKind,
 }
 

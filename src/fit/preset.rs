@@ -16,9 +16,12 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum FitPreset {
+    /// `covering`: knots over the whole sampled range, for plans with few samples per axis ([`FitOptions::covering`]).
     #[default]
     Covering,
+    /// `design`: the method's own settings ([`FitOptions::default`]), for dense plans.
     Design,
+    /// `design-stockinette`: `design` with the original stockinette material's layout ([`FitOptions::stockinette_like`]).
     DesignStockinette,
 }
 

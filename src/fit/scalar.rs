@@ -172,9 +172,13 @@ impl KinkRule {
 /// grid, a cell, or a sample by its plan index), and the two values compared.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Kink {
+    /// the term (e.g. `1D term 0 (s_x)`)
     pub term: String,
+    /// the rule that decided
     pub rule: KinkRule,
+    /// where: a knot, a cell or a sample
     pub site: String,
+    /// the two values compared
     pub values: [f64; 2],
 }
 
@@ -195,6 +199,7 @@ impl std::fmt::Display for Kink {
 /// The kinks of a tangent pass.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct KinkReport {
+    /// the kinks, in the order of the fit
     pub kinks: Vec<Kink>,
 }
 

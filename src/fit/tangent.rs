@@ -28,7 +28,9 @@ use num_dual::Dual64;
 /// Ψ̄̇ of a converged record, σ̇ when the slopes come from the stresses.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RecordTangent {
+    /// Ψ̄̇, the tangent of Ψ̄ (J/m²)
     pub psi: f64,
+    /// σ̇ per strain component (`None` where the record has no stress)
     pub stress: Option<[Option<f64>; 5]>,
 }
 

@@ -28,7 +28,9 @@ use std::f64::consts::PI;
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("{parameter}: {message}")]
 pub struct GenerateError {
+    /// the parameter's name
     pub parameter: String,
+    /// what is wrong
     pub message: String,
 }
 

@@ -21,15 +21,21 @@ pub enum Coefficient {
     Constant,
     /// 1D term number `term` (in `terms1d`): its value p (`slope` false) or slope m at knot `index`
     Term1D {
+        /// the term's index in `terms1d`
         term: usize,
+        /// the slope m (true) or the value p (false)
         slope: bool,
+        /// the knot
         index: usize,
     },
     /// 2D term number `term` (in `terms2d`): array 0 = p, 1 = ∂_u (mu), 2 = ∂_v (mv), 3 = ∂_uv (muv), at
     /// `index` = i_v n_u + i_u (the file's layout)
     Term2D {
+        /// the term's index in `terms2d`
         term: usize,
+        /// 0 = p, 1 = mu, 2 = mv, 3 = muv
         array: usize,
+        /// the knot, i_v n_u + i_u
         index: usize,
     },
 }
@@ -55,6 +61,7 @@ impl std::fmt::Display for Coefficient {
 /// One number per coefficient of a material, in its layout (e.g. dJ/dc_j).
 #[derive(Clone, Debug, PartialEq)]
 pub struct MaterialGradient {
+    /// the number for C₀
     pub constant: f64,
     /// per 1D term: [per knot for p, per knot for m]
     pub terms1d: Vec<[Vec<f64>; 2]>,
@@ -276,6 +283,7 @@ pub struct BasisEvaluator<'a> {
 }
 
 impl<'a> BasisEvaluator<'a> {
+    /// An evaluator for the coefficients of `material`.
     pub fn new(material: &'a Material) -> Self {
         BasisEvaluator {
             material,

@@ -92,8 +92,11 @@ pub fn locate_scaled(t: &[f64], scale: f64, x: f64) -> Piece {
 /// `Σ_j w[b][j] sʲ` with `s = (x − origin) / h`. The weights multiply (p_i, p_{i+1}, m_i, m_{i+1}) of `cell`.
 #[derive(Clone, Copy, Debug)]
 pub struct BasisPiece {
+    /// origin x₀ of the local coordinate s (the cell's left knot, or the end knot on an exterior piece)
     pub origin: f64,
+    /// length h of the cell (of the end cell on an exterior piece)
     pub h: f64,
+    /// power-basis coefficients: weight b is `Σ_j w[b][j] sʲ`
     pub w: [[f64; 4]; 4],
 }
 
@@ -142,8 +145,11 @@ pub fn basis_weights<D: Real>(t: &[f64], x: &D) -> (usize, [D; 4]) {
 /// A 1D cubic Hermite spline (knots t, values p, slopes m) with linear extrapolation.
 #[derive(Clone, Debug)]
 pub struct Hermite1D {
+    /// knots tᵢ (increasing)
     pub t: Vec<f64>,
+    /// values pᵢ at the knots
     pub p: Vec<f64>,
+    /// slopes mᵢ at the knots
     pub m: Vec<f64>,
     /// per piece: origin, 1/h and power-basis coefficients c₀..c₃ in s
     pieces: Vec<(f64, f64, [f64; 4])>,
@@ -188,6 +194,7 @@ impl Hermite1D {
         }
     }
 
+    /// The piece of x: 0 left of t₀, i for [tᵢ₋₁, tᵢ], n right of tₙ₋₁.
     #[inline(always)]
     pub fn piece(&self, x: f64) -> usize {
         locate_scaled(&self.t, self.scale, x).index
@@ -232,11 +239,17 @@ pub fn poly_derivs(c: &[f64; 4], s: f64, ih: f64) -> [f64; 4] {
 /// entry (iv, iu) at `iv·|tu| + iu` (the original's layout).
 #[derive(Clone, Debug)]
 pub struct Hermite2D {
+    /// knots along u (increasing)
     pub tu: Vec<f64>,
+    /// knots along v (increasing)
     pub tv: Vec<f64>,
+    /// values p at the knots
     pub p: Vec<f64>,
+    /// slopes ∂p/∂u at the knots
     pub mu: Vec<f64>,
+    /// slopes ∂p/∂v at the knots
     pub mv: Vec<f64>,
+    /// twists ∂²p/∂u∂v at the knots
     pub muv: Vec<f64>,
     /// per (u piece, v piece), u piece inner: origins, 1/h and coefficients c[i][j] of sⁱ tʲ
     pieces: Vec<Piece2>,
@@ -391,6 +404,7 @@ impl Hermite2D {
         }
     }
 
+    /// The piece of v along tv (as [`Hermite1D::piece`] along t).
     #[inline(always)]
     pub fn v_piece(&self, v: f64) -> usize {
         locate_scaled(&self.tv, self.scale_v, v).index

@@ -23,8 +23,11 @@ use std::path::Path;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{file}: {field}: {message}")]
 pub struct MaterialError {
+    /// the material file
     pub file: String,
+    /// the field (a JSON path such as `coeffs.1D[2].t[4]`, or a line and column)
     pub field: String,
+    /// what is wrong
     pub message: String,
 }
 

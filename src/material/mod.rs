@@ -28,14 +28,18 @@ pub use crate::strain::{Strain6, StrainComponent};
 /// A 1D term f_k of the material: k is its strain (the file's index k = 0…4: s_x, s_a, s_y, Π₀₀, Π₁₁).
 #[derive(Clone, Debug)]
 pub struct Term1D {
+    /// the strain component k
     pub strain: StrainComponent,
+    /// the spline f_k of z_k/σ_k (J/m²)
     pub spline: Hermite1D,
 }
 
 /// A 2D term f_kl of the material: strains (k, l), k in-plane, l after k.
 #[derive(Clone, Debug)]
 pub struct Term2D {
+    /// the strain components (k, l)
     pub strains: [StrainComponent; 2],
+    /// the spline f_kl of (z_k/σ_k, z_l/σ_l) (J/m²)
     pub spline: Hermite2D,
 }
 
@@ -48,7 +52,9 @@ pub struct Material {
     pub strain_scale: [f64; 5],
     /// C₀
     pub constant: f64,
+    /// the 1D terms f_k
     pub terms1d: Vec<Term1D>,
+    /// the 2D terms f_kl
     pub terms2d: Vec<Term2D>,
     /// top-level keys other than density, strain scale and coeffs (e.g. "strain shift", "meta"), in file order
     pub extra: serde_json::Map<String, serde_json::Value>,
@@ -65,16 +71,27 @@ pub const MAX_NORMALISED_STRAIN: f64 = 1e3;
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MaterialStrainError {
     #[error("{component} = {} is not finite", compact(*value))]
-    NotFinite { component: &'static str, value: f64 },
+    /// A strain component that is NaN or infinite.
+    NotFinite {
+        /// the component's name
+        component: &'static str,
+        /// its value
+        value: f64,
+    },
     #[error(
         "{component} = {} is outside the material's admissible range |{component}| ≤ {limit:e} \
          ({MAX_NORMALISED_STRAIN:e} strain scales σ = {scale})",
         compact(*value)
     )]
+    /// A strain component beyond [`MAX_NORMALISED_STRAIN`] strain scales.
     OutOfRange {
+        /// the component's name
         component: &'static str,
+        /// its value
         value: f64,
+        /// the largest admissible |z_k| (MAX_NORMALISED_STRAIN · σ_k)
         limit: f64,
+        /// the strain scale σ_k
         scale: f64,
     },
 }
@@ -82,8 +99,11 @@ pub enum MaterialStrainError {
 /// ψ, ∇ψ and ∇²ψ at one strain.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PsiVgh {
+    /// ψ(z) (J/m²)
     pub value: f64,
+    /// ∇ψ = ∂ψ/∂z (J/m² per unit strain; J/m per 1/m for the II components)
     pub grad: [f64; 6],
+    /// ∇²ψ = ∂²ψ/∂z² (symmetric)
     pub hess: [[f64; 6]; 6],
 }
 
@@ -94,6 +114,32 @@ impl Material {
     /// (k, kb)) share L/σ_kb, so their eigen-geometry is computed once and their derivatives are summed in the
     /// spectral variables ([`spectral::SpectralSum`]) before one chain rule to z per bending index.
     /// The Hessian is accumulated in its upper triangle and mirrored at the end.
+    ///
+    /// # Example
+    ///
+    /// ψ, ∇ψ and ∇²ψ of the default material at a stretched, sheared and bent strain: the gradient matches
+    /// central differences of the value and the Hessian is symmetric.
+    ///
+    /// ```
+    /// use hylc::material::synthetic::default_material;
+    ///
+    /// let m = default_material();
+    /// // z = (s_x, s_a, s_y, II₀₀ [1/m], II₀₁ [1/m], II₁₁ [1/m])
+    /// let z = [0.1, 0.2, -0.05, 20.0, 5.0, -10.0];
+    /// let e = m.eval(&z);
+    /// assert!(e.value.is_finite());
+    /// for k in 0..6 {
+    ///     let h = 1e-6 * z[k].abs().max(1.0);
+    ///     let (mut zp, mut zm) = (z, z);
+    ///     zp[k] += h;
+    ///     zm[k] -= h;
+    ///     let fd = (m.eval(&zp).value - m.eval(&zm).value) / (2.0 * h);
+    ///     assert!((e.grad[k] - fd).abs() <= 1e-6 * (e.grad[k].abs() + 1.0), "∂ψ/∂z_{k}");
+    ///     for l in 0..6 {
+    ///         assert!((e.hess[k][l] - e.hess[l][k]).abs() <= 1e-12 * (e.hess[k][l].abs() + 1.0));
+    ///     }
+    /// }
+    /// ```
     pub fn eval(&self, z: &[f64; 6]) -> PsiVgh {
         let inv = self.strain_scale.map(|s| 1.0 / s);
         let mut out = PsiVgh {

@@ -75,14 +75,20 @@ impl LambdaFamily for super::hermite::AtU<'_> {
 /// for the 11 component), q = δ² + b², d = √q and the eigenvalues λ₁,₂ = m ± d.
 #[derive(Clone, Copy, Debug)]
 pub struct Eigen2 {
+    /// m = (L₀₀ + L₁₁)/2, the mean of the eigenvalues
     pub m: f64,
+    /// δ = (L₀₀ − L₁₁)/2 (sign-flipped for the 11 component)
     pub delta: f64,
+    /// b = L₀₁
     pub b: f64,
+    /// q = δ² + b²
     pub q: f64,
+    /// d = √q, half the eigenvalue gap
     pub d: f64,
 }
 
 impl Eigen2 {
+    /// The geometry of m, δ, b (q and d computed).
     #[inline(always)]
     pub fn new(m: f64, delta: f64, b: f64) -> Eigen2 {
         let q = delta * delta + b * b;
@@ -123,11 +129,17 @@ pub struct SpectralSum {
 /// each u_k its first and second derivative and the mixed derivatives ∂²/∂u_k ∂w.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct SpectralW {
+    /// the value
     pub value: f64,
+    /// gradient in w = (m, δ, b)
     pub g: [f64; 3],
+    /// Hessian in w, packed (mm, mδ, mb, δδ, δb, bb)
     pub h: [f64; 6],
+    /// ∂/∂u_k
     pub gu: [f64; 3],
+    /// ∂²/∂u_k²
     pub huu: [f64; 3],
+    /// ∂²/∂u_k ∂w, row k
     pub hu: [[f64; 3]; 3],
 }
 

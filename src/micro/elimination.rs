@@ -19,11 +19,17 @@ use std::collections::BTreeSet;
 /// The kinematics of a pattern at one macro strain.
 #[derive(Clone, Debug)]
 pub struct Elimination {
+    /// The macro strain.
     pub strain: MacroStrain,
+    /// The surface map family.
     pub family: Family,
+    /// The surface map φ of the strain.
     pub map: SurfaceMap<f64>,
+    /// The reference periods (p₁, p₂) (m).
     pub periods: [f64; 2],
+    /// The vertex dof map x_v = b_v + R_v ũ_v.
     pub dofs: DofMap,
+    /// The rigid transforms of the periodic copies.
     pub transforms: TileTransforms,
 }
 

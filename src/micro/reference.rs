@@ -23,7 +23,9 @@ use serde::{Deserialize, Serialize};
 /// Knitted or woven: selects the tension factors.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Construction {
+    /// Knitted: rest lengths × 0.9 and rest curvatures × 0.8.
     Knitted,
+    /// Woven: rest curvatures × 0.9.
     Woven,
 }
 
@@ -74,14 +76,17 @@ impl Default for ReferenceOptions {
 pub struct ReferenceReport {
     /// Stress-free rounds and the relaxed energy after the last one (J).
     pub rounds: usize,
+    /// The relaxed energy after the last stress-free round (J).
     pub stress_free_energy: f64,
     /// Strains (s_x, s_y) of the in-plane minimum relative to the tensioned pattern's periods.
     pub period_strain: [f64; 2],
     /// Newton iterations of the in-plane minimum and the final tile forces |∂E/∂s_k|/p_k (N).
     pub period_steps: usize,
+    /// The final tile forces |∂E/∂s_k|/p_k (N).
     pub residual_force: [f64; 2],
     /// Periods before and after.
     pub periods_in: [f64; 2],
+    /// The periods after (m).
     pub periods_out: [f64; 2],
     /// Ψ̄ of the final reference state (J/m²).
     pub psi: f64,
@@ -92,19 +97,28 @@ pub struct ReferenceReport {
 /// Why the reference computation failed.
 #[derive(Debug, thiserror::Error)]
 pub enum ReferenceError {
+    /// A micro solve stopped with an error.
     #[error(transparent)]
     Solve(#[from] MicroError),
     /// A micro solve of the computation did not converge; `stage` says which ("stress-free round 3", "in-plane
     /// minimum at (…)", "final reference state").
     #[error("{stage}: {source}")]
-    Unconverged { stage: String, source: NotConverged },
+    Unconverged {
+        /// which solve
+        stage: String,
+        /// how it ended
+        source: NotConverged,
+    },
     /// Step 1 did not reach a stress-free state within the allowed rounds.
     #[error(
         "no stress-free state after {rounds} rounds: relaxed energy {energy:.3e} J (target {target:.3e} J)"
     )]
     NoStressFreeState {
+        /// stress-free rounds made
         rounds: usize,
+        /// the relaxed energy after the last (J)
         energy: f64,
+        /// the target 1e-10 · k_s · (mean rest length) (J)
         target: f64,
     },
     /// Step 3 did not reach zero tile forces within the allowed Newton steps.
@@ -114,8 +128,11 @@ pub enum ReferenceError {
         .force[1]
     )]
     NoZeroStressPeriods {
+        /// Newton steps made
         steps: usize,
+        /// the final tile forces |∂E/∂s_k|/p_k (N)
         force: [f64; 2],
+        /// the target force (N)
         tolerance: f64,
     },
     /// Step 3 found no strain step that lowers the tile forces.
@@ -126,7 +143,12 @@ pub enum ReferenceError {
         .force[0],
         .force[1]
     )]
-    PeriodSearchStalled { s: [f64; 2], force: [f64; 2] },
+    PeriodSearchStalled {
+        /// the strains (s_x, s_y) reached
+        s: [f64; 2],
+        /// the tile forces there (N)
+        force: [f64; 2],
+    },
 }
 
 /// The error of a micro solve at `stage` that did not converge.

@@ -60,23 +60,31 @@ impl fmt::Display for Status {
 /// Errors that stop a solve before it runs or in the middle (bad input, overlapping yarns at the start).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MicroError {
+    /// An inadmissible macro strain.
     #[error(transparent)]
     Strain(#[from] StrainError),
+    /// The contact pairs could not be built (e.g. overlapping yarns at the start).
     #[error("contact: {0}")]
     Contact(#[from] ContactError),
+    /// The KKT system could not be factorised.
     #[error("linear solve: {0}")]
     Linear(#[from] FactorError),
     /// A quantity defined at an equilibrium asked of a solve that did not converge.
     #[error("{what} need an equilibrium: {source}")]
     NeedsEquilibrium {
+        /// What needs the equilibrium (e.g. "equilibrium sensitivities").
         what: &'static str,
+        /// How the solve ended instead.
         source: NotConverged,
     },
     /// A constraint row of [`MicroProblem::with_constraints`] with the wrong number of entries.
     #[error("constraint row {row} has {len} entries, expected {expected}")]
     ConstraintLength {
+        /// The row's index.
         row: usize,
+        /// Its number of entries.
         len: usize,
+        /// The number required (4n).
         expected: usize,
     },
     /// The tile energy (or Ψ̄ = E / (p₁ p₂)) is infinite or NaN at an iterate: the pattern or the start state is
@@ -86,22 +94,32 @@ pub enum MicroError {
          its start state is not physical)"
     )]
     NonFiniteEnergy {
+        /// The macro strain of the solve.
         strain: MacroStrain,
+        /// Newton steps taken.
         steps: usize,
+        /// The tile energy (J).
         energy: f64,
     },
     /// A constraint row of [`MicroProblem::with_constraints`] that cannot be normalised.
     #[error("constraint row {row} is zero or not finite")]
-    ConstraintRow { row: usize },
+    ConstraintRow {
+        /// The row's index.
+        row: usize,
+    },
 }
 
 /// A yarn state at a macro strain: the unknowns y = (ũ, θ) in the tile's dof layout and the stored frames
 /// (world coordinates) at that state.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MicroState {
+    /// The macro strain z = (s_x, s_a, s_y, Π₀₀, Π₁₁) of the state.
     pub strain: MacroStrain,
+    /// The surface map family that embeds the tile at this strain.
     pub family: Family,
+    /// The unknowns y = (ũ, θ): the displacement of each vertex in its local frame (m), then the edge angles (rad).
     pub y: Vec<f64>,
+    /// The stored rod frames (world coordinates) at this state.
     pub frames: RodState,
 }
 
@@ -123,7 +141,9 @@ pub struct Timings {
 /// The outcome of one solve.
 #[derive(Clone, Debug)]
 pub struct Solution {
+    /// The final state.
     pub state: MicroState,
+    /// How the solve ended.
     pub status: Status,
     /// Newton steps taken.
     pub steps: usize,
@@ -133,6 +153,7 @@ pub struct Solution {
     pub gradient_norm: f64,
     /// Wall time (s).
     pub time: f64,
+    /// Where the wall time went.
     pub timings: Timings,
     /// The reference area p₁ p₂ (m²).
     pub area: f64,
@@ -153,8 +174,11 @@ pub struct Solution {
     "the micro solve did not converge ({status} after {steps} steps, ‖g‖∞ = {gradient_norm:.3e} N)"
 )]
 pub struct NotConverged {
+    /// How the solve ended.
     pub status: Status,
+    /// Newton steps taken.
     pub steps: usize,
+    /// Final ‖g‖_∞ of the projected reduced gradient (N).
     pub gradient_norm: f64,
 }
 
@@ -181,8 +205,11 @@ impl Solution {
 
 /// One pattern with its material and options, ready to solve at any strain.
 pub struct MicroProblem {
+    /// The pattern (its reference state).
     pub pattern: Pattern,
+    /// The yarn material (radius the pattern's).
     pub material: YarnMaterial,
+    /// The solver options.
     pub options: SolverOptions,
     pub(super) topology: RodTopology,
     /// Constraint rows A (length 4n each; zero on the angles), normalised.
@@ -387,6 +414,35 @@ impl MicroProblem {
     }
 
     /// Solve at `strain`, starting from `start` (the reference state when `None`).
+    ///
+    /// # Example
+    ///
+    /// A cold solve of the generated plain weave (used as generated; `hylc run` first brings a pattern to its
+    /// reference state, [`super::reference`]) at 5 % stretch along ξ₁, then a warm one next to it: the
+    /// envelope-theorem stress σ_x = ∂Ψ̄/∂s_x matches the central difference of Ψ̄.
+    ///
+    /// ```
+    /// use hylc::generate::default_pattern;
+    /// use hylc::micro::envelope::energy_strain_gradient;
+    /// use hylc::micro::{MacroStrain, MicroProblem, SolverOptions, Status};
+    /// use hylc::rod::YarnMaterial;
+    ///
+    /// let pattern = default_pattern("plain")?;
+    /// let problem = MicroProblem::new(pattern, &YarnMaterial::default(), SolverOptions::default());
+    /// let at = |s_x: f64| MacroStrain::new(s_x, 0.0, 0.0, 0.0, 0.0);
+    /// let mid = problem.solve(&at(0.05), None)?;
+    /// assert_eq!(mid.status, Status::Converged);
+    /// let psi = mid.psi()?; // Ψ̄ = E / (p₁ p₂), J/m²
+    /// assert!(psi > 0.0);
+    ///
+    /// let h = 1e-4;
+    /// let plus = problem.solve(&at(0.05 + h), Some(&mid.state))?.psi()?;
+    /// let minus = problem.solve(&at(0.05 - h), Some(&mid.state))?.psi()?;
+    /// let sigma_x = energy_strain_gradient(&problem, &mid.state)?[0].unwrap() / mid.area;
+    /// let fd = (plus - minus) / (2.0 * h);
+    /// assert!((sigma_x - fd).abs() <= 1e-3 * sigma_x.abs(), "{sigma_x} vs {fd}");
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn solve(
         &self,
         strain: &MacroStrain,

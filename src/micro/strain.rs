@@ -48,7 +48,9 @@ pub const MAX_CURVATURE_RADIUS: f64 = 1.0;
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("strain {strain}: {message}")]
 pub struct StrainError {
+    /// the strain
     pub strain: MacroStrain,
+    /// why it is outside the set
     pub message: String,
 }
 
@@ -61,8 +63,10 @@ impl fmt::Display for MacroStrain {
 }
 
 impl MacroStrain {
+    /// The zero strain.
     pub const ZERO: MacroStrain = MacroStrain([0.0; 5]);
 
+    /// The strain (s_x, s_a, s_y, Π₀₀, Π₁₁).
     pub fn new(s_x: f64, s_a: f64, s_y: f64, ii00: f64, ii11: f64) -> Self {
         MacroStrain([s_x, s_a, s_y, ii00, ii11])
     }

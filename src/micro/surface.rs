@@ -30,6 +30,7 @@ pub fn sinc<D: Real>(x: &D) -> D {
 /// One of the closed-form surface maps for a strain, generic over the scalar.
 #[derive(Clone, Debug)]
 pub struct SurfaceMap<D> {
+    /// the map's family
     pub family: Family,
     a: D,
     b: D,

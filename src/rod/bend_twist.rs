@@ -24,9 +24,13 @@ use nalgebra::{SMatrix, SVector, Vector3};
 /// state, and the (continuous) reference twist there.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StencilFrames {
+    /// unit tangent t⁰ of the first edge
     pub t0: Vector3<f64>,
+    /// reference director u⁰ of the first edge
     pub u0: Vector3<f64>,
+    /// unit tangent t¹ of the second edge
     pub t1: Vector3<f64>,
+    /// reference director u¹ of the second edge
     pub u1: Vector3<f64>,
     /// Reference twist τ at the stored state (continuous in time, may lie outside (−π, π]).
     pub twist: f64,
@@ -35,6 +39,7 @@ pub struct StencilFrames {
 }
 
 impl StencilFrames {
+    /// The frames with the reference twist τ (its raw angle computed).
     pub fn new(
         t0: Vector3<f64>,
         u0: Vector3<f64>,
@@ -82,6 +87,7 @@ pub struct StencilKinematics {
     pub twist: f64,
     /// Transported reference directors of the two edges.
     pub u0: Vector3<f64>,
+    /// Transported reference director of the second edge (u¹; the one above is u⁰).
     pub u1: Vector3<f64>,
 }
 

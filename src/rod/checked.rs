@@ -17,16 +17,25 @@ pub enum RodError {
     /// An input is not finite or beyond its bound.
     #[error("rod stencil: {what} = {value} is not finite or beyond ±{limit:e}")]
     Input {
+        /// which input
         what: &'static str,
+        /// its value
         value: f64,
+        /// its bound
         limit: f64,
     },
     /// An edge of zero length (its tangent is undefined).
     #[error("rod stencil: edge {edge} has zero length")]
-    ZeroLength { edge: usize },
+    ZeroLength {
+        /// the edge (0 or 1)
+        edge: usize,
+    },
     /// The result overflowed.
     #[error("rod stencil: the {what} is not finite (the inputs are too extreme)")]
-    NonFinite { what: &'static str },
+    NonFinite {
+        /// the quantity that overflowed
+        what: &'static str,
+    },
 }
 
 fn check(what: &'static str, value: f64, limit: f64) -> Result<(), RodError> {

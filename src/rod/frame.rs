@@ -105,11 +105,15 @@ pub fn continuous_twist(stored: f64, raw_stored: f64, raw_new: f64) -> f64 {
 ///   ∂²uᵢ/∂tⱼ∂tₖ = −wᵢ ∂²q/∂tⱼ∂tₖ − δᵢₖ ∂q/∂tⱼ − δᵢⱼ ∂q/∂tₖ, then the chain rule through t(e);
 /// - v = t × u by the product rule.
 pub struct EdgeFrame {
+    /// unit tangent t = e/|e|
     pub t: VJet<3>,
+    /// reference director u, ū transported to t
     pub u: VJet<3>,
+    /// v = t × u
     pub v: VJet<3>,
 }
 
+/// The frame of edge `e`, transporting the stored director `ubar` from the stored tangent `a`, with derivatives over e (formulas above).
 pub fn edge_frame(e: &Vector3<f64>, a: &Vector3<f64>, ubar: &Vector3<f64>) -> EdgeFrame {
     let l = e.norm();
     let t = e / l;

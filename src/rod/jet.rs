@@ -10,8 +10,11 @@ use nalgebra::{SMatrix, SVector, Vector3};
 /// A scalar with its gradient and Hessian over `N` variables.
 #[derive(Clone, Copy, Debug)]
 pub struct Jet<const N: usize> {
+    /// the value
     pub v: f64,
+    /// the gradient
     pub g: SVector<f64, N>,
+    /// the Hessian
     pub h: SMatrix<f64, N, N>,
 }
 
@@ -32,6 +35,7 @@ impl<const N: usize> Jet<N> {
         j
     }
 
+    /// Sum a + b.
     pub fn add(&self, o: &Self) -> Self {
         Jet {
             v: self.v + o.v,
@@ -40,6 +44,7 @@ impl<const N: usize> Jet<N> {
         }
     }
 
+    /// Difference a − b.
     pub fn sub(&self, o: &Self) -> Self {
         Jet {
             v: self.v - o.v,
@@ -48,6 +53,7 @@ impl<const N: usize> Jet<N> {
         }
     }
 
+    /// Product with the constant s.
     pub fn scale(&self, s: f64) -> Self {
         Jet {
             v: self.v * s,
@@ -117,8 +123,11 @@ impl<const N: usize> Jet<N> {
 /// A 3-vector with its Jacobian (3×N) and the Hessian of each component over `N` variables.
 #[derive(Clone, Copy, Debug)]
 pub struct VJet<const N: usize> {
+    /// the vector
     pub v: Vector3<f64>,
+    /// its Jacobian (3 × N)
     pub j: SMatrix<f64, 3, N>,
+    /// the Hessian of each component
     pub h: [SMatrix<f64, N, N>; 3],
 }
 

@@ -69,26 +69,41 @@ pub const MAX_CONTACT_QUADRATURE: usize = 32;
 /// A yarn file or yarn parameters that cannot be used.
 #[derive(Debug, thiserror::Error)]
 pub enum YarnFileError {
+    /// The file could not be read.
     #[error("{}: cannot read: {source}", path.display())]
     Read {
+        /// The file.
         path: PathBuf,
+        /// The I/O error.
         source: std::io::Error,
     },
+    /// The file could not be written.
     #[error("{}: cannot write: {source}", path.display())]
     Write {
+        /// The file.
         path: PathBuf,
+        /// The I/O error.
         source: std::io::Error,
     },
     /// Not JSON, not an object, an unknown or a missing key, a value of the wrong type (serde's message names
     /// the key and the line).
     #[error("{}: {message}", path.display())]
-    Parse { path: PathBuf, message: String },
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// serde's message.
+        message: String,
+    },
     /// A value outside the admissible range.
     #[error("{}key `{key}` = {value}: {expected}", where_prefix(.path))]
     Value {
+        /// The file, when the parameters came from one.
         path: Option<PathBuf>,
+        /// The key.
         key: &'static str,
+        /// Its value.
         value: f64,
+        /// The admissible range.
         expected: &'static str,
     },
 }

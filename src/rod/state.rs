@@ -15,7 +15,9 @@ use nalgebra::Vector3;
 /// (previous vertex, its offset), (i, [0, 0]), (next vertex, its offset).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StencilDofs {
+    /// previous vertex, centre vertex i, next vertex
     pub vertices: [usize; 3],
+    /// the image offset of each of the three vertices
     pub offsets: [[i32; 2]; 3],
     /// The edges (= their start vertices) carrying θ⁰ and θ¹.
     pub edges: [usize; 2],
@@ -24,10 +26,12 @@ pub struct StencilDofs {
 /// Topology of the rod network of a pattern: the bending stencil of every vertex.
 #[derive(Clone, Debug)]
 pub struct RodTopology {
+    /// one stencil per vertex, indexed by its centre vertex
     pub stencils: Vec<StencilDofs>,
 }
 
 impl RodTopology {
+    /// The stencils of pattern `p`.
     pub fn new(p: &Pattern) -> Self {
         let prev = p.prev();
         let stencils = (0..p.len())

@@ -21,25 +21,37 @@ use std::path::PathBuf;
 /// Errors of sampling: a bad plan or argument, a sample file or strain log that cannot be read or written.
 #[derive(Debug, thiserror::Error)]
 pub enum SampleError {
+    /// A bad sampling plan.
     #[error(transparent)]
     Plan(#[from] PlanError),
     /// A file operation failed.
     #[error("{}: {action}: {source}", path.display())]
     Io {
+        /// the file or folder
         path: PathBuf,
+        /// what was being done ("cannot read", …)
         action: &'static str,
+        /// the I/O error
         source: std::io::Error,
     },
     /// A line of a file is not what it should be.
     #[error("{}:{line}: {message}", path.display())]
     Line {
+        /// the file
         path: PathBuf,
+        /// the line (1-based)
         line: usize,
+        /// what is wrong
         message: String,
     },
     /// A file as a whole is not what it should be.
     #[error("{}: {message}", path.display())]
-    File { path: PathBuf, message: String },
+    File {
+        /// the file
+        path: PathBuf,
+        /// what is wrong
+        message: String,
+    },
     /// A shard that is not `k/n` with 0 ≤ k < n.
     #[error("--shard: expected k/n with 0 ≤ k < n, got {0:?}")]
     Shard(String),

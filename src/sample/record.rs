@@ -66,11 +66,17 @@ pub struct Record {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PerParameter<T> {
+    /// for Young's modulus Y (Pa)
     pub young: T,
+    /// for the shear modulus G (Pa)
     pub shear: T,
+    /// for the bending-twisting factor γ
     pub bend_twist_factor: T,
+    /// for the contact stiffness k_c (J/m²)
     pub contact_stiffness: T,
+    /// for the contact radius factor f
     pub contact_radius_factor: T,
+    /// for the yarn radius r (m)
     pub radius: T,
 }
 
@@ -141,10 +147,15 @@ impl Record {
 /// How a sample's solve ended: the solver's [`Status`], or `Error` when it could not run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum SampleStatus {
+    /// The solver converged.
     Converged,
+    /// No trial step lowered the energy.
     Stalled,
+    /// The step limit was reached.
     MaxSteps,
+    /// The time limit was reached.
     TimeLimit,
+    /// The solve could not run or stopped with an error.
     Error,
 }
 
@@ -193,9 +204,13 @@ pub enum StartKind {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StartResult {
+    /// which start
     pub kind: StartKind,
+    /// Ψ̄ (J/m²) when converged, else null
     pub psi: Option<f64>,
+    /// how its solve ended
     pub status: SampleStatus,
+    /// Newton steps
     pub steps: usize,
     /// Yarn crossings of this start's path that do not cancel (omitted when not checked).
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -76,6 +76,7 @@ pub struct RunSummary {
     /// Finished records of the selected chains that lacked sensitivities, and of these the ones given them (the
     /// others were re-solved to another result, or their sensitivities could not be computed).
     pub lacking_sensitivities: usize,
+    /// Of `lacking_sensitivities`, the records given them.
     pub sensitivities_added: usize,
     /// Wall time (s).
     pub time: f64,
@@ -162,6 +163,39 @@ fn record_line(record: &Record) -> String {
 }
 
 /// Run `plan` on `problem`, appending to the sample file `out` (created if missing; finished ids skipped).
+///
+/// # Example
+///
+/// A three-sample plan (the 1D range of s_x over [−0.05, 0.05], no other range or grid) on the generated plain
+/// weave: every sample converges, and a second run finds the file finished and writes nothing.
+///
+/// ```
+/// use hylc::generate::default_pattern;
+/// use hylc::micro::{MicroProblem, SolverOptions};
+/// use hylc::rod::YarnMaterial;
+/// use hylc::sample::{read_samples, run_plan, Plan, RunOptions};
+///
+/// let pattern = default_pattern("plain")?;
+/// let problem = MicroProblem::new(pattern, &YarnMaterial::default(), SolverOptions::default());
+/// let mut plan = Plan {
+///     count_1d: 0,
+///     count_2d: 0,
+///     pairs: vec![],
+///     counts_1d: Some([3, 0, 0, 0, 0]),
+///     ..Plan::default()
+/// };
+/// plan.ranges.s_x = [-0.05, 0.05];
+/// let out = std::env::temp_dir().join(format!("hylc-doc-run-plan-{}.jsonl", std::process::id()));
+/// let _ = std::fs::remove_file(&out);
+///
+/// let summary = run_plan(&problem, &plan, &out, &RunOptions::default())?;
+/// assert_eq!((summary.written, summary.converged), (3, 3));
+/// let records = read_samples(&out, false)?;
+/// assert!(records.iter().all(|r| r.psi.is_some_and(|psi| psi > 0.0))); // Ψ̄ in J/m²
+/// assert_eq!(run_plan(&problem, &plan, &out, &RunOptions::default())?.written, 0);
+/// std::fs::remove_file(&out)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn run_plan(
     problem: &MicroProblem,
     plan: &Plan,

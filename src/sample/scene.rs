@@ -14,7 +14,9 @@ use std::path::Path;
 /// The extremes of each macro strain component over a run (min, max per component of z).
 #[derive(Clone, Debug, PartialEq)]
 pub struct StrainExtent {
+    /// componentwise minimum of z = (s_x, s_a, s_y, II₀₀, II₀₁, II₁₁)
     pub min: [f64; 6],
+    /// componentwise maximum of z
     pub max: [f64; 6],
     /// steps read
     pub steps: usize,
@@ -133,7 +135,9 @@ pub struct ScenePlanReport {
     pub ranges: [[f64; 2]; 5],
     /// each range's share of the base range in the spacing coordinate
     pub fraction: [f64; 5],
+    /// samples of the base plan
     pub base_samples: usize,
+    /// samples of the derived plan
     pub samples: usize,
 }
 

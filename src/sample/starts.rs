@@ -105,10 +105,15 @@ pub(super) fn disagree(solves: &[Solve], rel: f64) -> bool {
 /// A sample converged in both files whose Ψ̄ differ by more than the tolerance.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Disagreement {
+    /// The sample's id.
     pub id: String,
+    /// Its index in the plan.
     pub index: usize,
+    /// Its strain z = (s_x, s_a, s_y, Π₀₀, Π₁₁).
     pub z: [f64; 5],
+    /// Ψ̄ in the first file (J/m²).
     pub psi_a: f64,
+    /// Ψ̄ in the second file (J/m²).
     pub psi_b: f64,
     /// |Ψ̄_a − Ψ̄_b| / max(|Ψ̄_a|, |Ψ̄_b|) (0 when both are 0).
     pub relative: f64,
@@ -121,10 +126,13 @@ pub struct Comparison {
     pub common: usize,
     /// Ids in only one of the files.
     pub only_a: usize,
+    /// Ids in the second file only.
     pub only_b: usize,
     /// Of the common ids: converged in both, in one only, in neither.
     pub both_converged: usize,
+    /// Common ids converged in one file only.
     pub one_converged: usize,
+    /// Common ids converged in neither file.
     pub neither_converged: usize,
     /// Converged in both and within the tolerance.
     pub agree: usize,

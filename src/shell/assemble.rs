@@ -198,6 +198,7 @@ pub fn zero_absent_flaps(h: &mut [[f64; NDOF]; NDOF], s: &Stencil, bending: bool
 /// Result of one assembly.
 #[derive(Clone, Debug)]
 pub struct Assembled {
+    /// elastic energy E = Σ k A ψ(S z) (barriers included) (J)
     pub energy: f64,
     /// gradient over all 3n dofs (constrained ones included, for reaction forces)
     pub grad: Vec<f64>,
@@ -207,6 +208,7 @@ pub struct Assembled {
     pub values_exact: Vec<f64>,
     /// componentwise min and max of z over the mesh
     pub zmin: [f64; 6],
+    /// componentwise max of z over the mesh
     pub zmax: [f64; 6],
     /// z of every triangle, in stencil order
     pub z: Vec<[f64; 6]>,

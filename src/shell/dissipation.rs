@@ -20,8 +20,11 @@ use crate::real::{c, Real};
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Wind {
+    /// air density ρ (kg/m³)
     pub density: f64,
+    /// tangential drag d (kg/(m² s))
     pub drag: f64,
+    /// wind velocity w (m/s)
     pub velocity: [f64; 3],
 }
 

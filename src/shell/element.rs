@@ -77,10 +77,15 @@ impl Default for ModelFlags {
 /// The per-triangle model: reduced material, multipliers, PSD option.
 #[derive(Clone, Debug)]
 pub struct ElementModel {
+    /// the material, reduced to the terms the scene needs
     pub material: Material,
+    /// whether the bending strains are evaluated
     pub bending: bool,
+    /// stiffness multiplier k
     pub stiffness: f64,
+    /// bending scale β (multiplies II before ψ)
     pub bending_scale: f64,
+    /// how the element Hessians are made positive semi-definite
     pub psd: Psd,
     /// the fold barrier; `None` without bending
     pub fold: Option<FoldBarrier>,

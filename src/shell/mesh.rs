@@ -26,7 +26,9 @@ pub const MAX_TRIANGLES: usize = 2 * MAX_VERTICES;
 /// A flat triangle mesh: rest layout (m) and triangles (vertex indices).
 #[derive(Clone, Debug)]
 pub struct Mesh {
+    /// rest layout of the vertices (m)
     pub rest: Vec<[f64; 2]>,
+    /// triangles (vertex indices)
     pub tris: Vec<[usize; 3]>,
     /// where each triangle came from, for error messages (e.g. "cloth.obj:12")
     pub origin: Vec<String>,
@@ -36,8 +38,11 @@ pub struct Mesh {
 /// flap repeats v₀ and is flagged false), rest data.
 #[derive(Clone, Copy, Debug)]
 pub struct Stencil {
+    /// the triangle's vertices v₀, v₁, v₂, then the flap vertices across (v₀,v₁), (v₁,v₂), (v₂,v₀)
     pub v: [usize; 6],
+    /// which flaps exist (a boundary edge has none)
     pub flaps: [bool; 3],
+    /// the triangle's rest data
     pub rest: RestTriangle,
 }
 

@@ -37,54 +37,76 @@ pub enum ShellError {
     /// A file or folder could not be read or written.
     #[error("{}: {action}: {source}", path.display())]
     Io {
+        /// the file or folder
         path: PathBuf,
         /// What was being done ("cannot read", "cannot write", …).
         action: &'static str,
+        /// the underlying I/O error
         source: std::io::Error,
     },
     /// A PNG snapshot could not be encoded or written.
     #[error("{}: cannot write PNG: {source}", path.display())]
     Png {
+        /// the PNG file
         path: PathBuf,
+        /// the encoder's error
         source: image::ImageError,
     },
     /// A scene file that is not valid scene JSON (syntax, unknown or missing keys, wrong types).
     #[error("{file}: {source}")]
     Json {
+        /// the scene file
         file: String,
+        /// the parser's error (with line and column)
         source: serde_json::Error,
     },
     /// Neither a scene file nor the name of a built-in scene.
     #[error("{name}: no such scene file and not a built-in scene ({})", scene::BUILTINS.join(", "))]
-    UnknownScene { name: String },
+    UnknownScene {
+        /// the argument given
+        name: String,
+    },
     /// An ARCSim scene file (`arcsim`) that is not JSON with comments: the file, line and column at fault.
     #[error("{file}:{line}:{column}: not an ARCSim scene file: {message}")]
     ArcsimSyntax {
+        /// the ARCSim file
         file: String,
+        /// line (1-based)
         line: usize,
+        /// column (1-based)
         column: usize,
+        /// what is wrong
         message: String,
     },
     /// A key of an ARCSim scene file (`arcsim`) that is missing, of the wrong type or out of range: the file,
     /// the line of the value (or of the enclosing object for a missing key) and the key's path.
     #[error("{file}:{line}: key `{key}`: {message}")]
     Arcsim {
+        /// the ARCSim file
         file: String,
+        /// line (1-based) of the value, or of the enclosing object for a missing key
         line: usize,
+        /// the key's path
         key: String,
+        /// what is wrong
         message: String,
     },
     /// A scene field with a value the scene cannot use.
     #[error("{file}: field `{field}`: {message}")]
     Scene {
+        /// the scene file
         file: String,
+        /// the field's path
         field: String,
+        /// what is wrong
         message: String,
     },
     /// A vertex selection of a scene (a pin or a handle) that cannot be used.
     #[error("{file}: field `{field}` {problem}")]
     Selection {
+        /// the scene file
         file: String,
+        /// the selection's field path
         field: String,
         /// "selects no vertex"
         problem: &'static str,
@@ -92,60 +114,102 @@ pub enum ShellError {
     /// A vertex selection of a scene listing a vertex index the mesh does not have.
     #[error("{file}: field `{field}`: vertex index {index} out of range (the mesh has {vertices} vertices, 0-based)")]
     SelectionIndex {
+        /// the scene file
         file: String,
+        /// the selection's field path
         field: String,
+        /// the listed vertex index (0-based)
         index: usize,
+        /// the number of vertices of the mesh
         vertices: usize,
     },
     /// The material file a scene names could not be loaded.
     #[error("{file}: field `material`: {source}")]
     Material {
+        /// the scene file
         file: String,
+        /// the material loader's error
         source: crate::material::json::MaterialError,
     },
     /// The rectangle mesh a scene describes could not be generated.
     #[error("{file}: field `mesh`: {source}")]
     SceneMesh {
+        /// the scene file
         file: String,
+        /// the mesh generator's error
         source: Box<ShellError>,
     },
     /// An obstacle mesh that cannot be used (not a manifold, consistently oriented triangle mesh).
     #[error("{file}: {problem}")]
-    ObstacleMesh { file: String, problem: String },
+    ObstacleMesh {
+        /// the obstacle's OBJ file
+        file: String,
+        /// what is wrong
+        problem: String,
+    },
     /// A time tolerance that is not a positive finite length.
     #[error("time tolerance {tol}: expected a positive finite length (m)")]
-    TimeTolerance { tol: f64 },
+    TimeTolerance {
+        /// the tolerance given (m)
+        tol: f64,
+    },
     /// Zero substeps per step.
     #[error("substeps per step: expected at least 1, got 0")]
     Substeps,
     /// More obstacle motions than obstacles were given to a simulation.
     #[error("{motions} obstacle motions for {obstacles} obstacles (one per obstacle at most)")]
-    ObstacleMotions { motions: usize, obstacles: usize },
+    ObstacleMotions {
+        /// the number of motions given
+        motions: usize,
+        /// the number of obstacles
+        obstacles: usize,
+    },
     /// A scene's simulation could not be set up.
     #[error("{file}: {source}")]
     SceneSetup {
+        /// the scene file
         file: String,
+        /// the setup's error
         source: Box<ShellError>,
     },
     /// Bad rectangle dimensions.
     #[error("rectangle: {message}")]
-    Rectangle { message: String },
+    Rectangle {
+        /// what is wrong
+        message: String,
+    },
     /// A problem in an OBJ file, at a line when it has one.
     #[error("{file}{}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
     Obj {
+        /// the OBJ file
         file: String,
+        /// line (1-based), if the problem has one
         line: Option<usize>,
+        /// what is wrong
         message: String,
     },
     /// A bad triangle of a mesh; `origin` is where it came from (`file:line`, or a rectangle's triangle number).
     #[error("{origin}: {message}")]
-    Triangle { origin: String, message: String },
+    Triangle {
+        /// where the triangle came from (`file:line` or a rectangle's triangle number)
+        origin: String,
+        /// what is wrong
+        message: String,
+    },
     /// A time step that is not a positive number.
     #[error("time step must be positive, got {dt}")]
-    TimeStep { dt: f64 },
+    TimeStep {
+        /// the time step given (s)
+        dt: f64,
+    },
     /// A pinned or handle vertex that the mesh does not have.
     #[error("constrained vertex {vertex} out of range ({vertices} vertices)")]
-    VertexOutOfRange { vertex: usize, vertices: usize },
+    VertexOutOfRange {
+        /// the vertex index (0-based)
+        vertex: usize,
+        /// the number of vertices of the mesh
+        vertices: usize,
+    },
     /// A vertex without positive mass in a dynamic simulation.
     #[error(
         "every vertex needs a positive mass (material density, mass multiplier, unused vertices?)"
@@ -153,7 +217,10 @@ pub enum ShellError {
     Mass,
     /// The symbolic analysis of the Newton matrix failed.
     #[error("symbolic factorisation failed: {source:?}")]
-    Symbolic { source: faer::sparse::FaerError },
+    Symbolic {
+        /// faer's error
+        source: faer::sparse::FaerError,
+    },
     /// A triangle of the initial state is degenerate.
     #[error("a triangle is degenerate in the initial state")]
     DegenerateInitial,
@@ -162,10 +229,18 @@ pub enum ShellError {
         "step {step} (t = {time:.4} s): a triangle is degenerate at the start of the step (handles moved too far \
          in one step?)"
     )]
-    DegenerateStart { step: usize, time: f64 },
+    DegenerateStart {
+        /// the step number
+        step: usize,
+        /// the simulated time (s)
+        time: f64,
+    },
     /// A triangle became degenerate during a step's Newton iterations.
     #[error("step {step}: a triangle became degenerate")]
-    Degenerate { step: usize },
+    Degenerate {
+        /// the step number
+        step: usize,
+    },
     /// The material's energy is not finite (NaN or infinite) at a triangle's strain, in the initial state
     /// (`step` None) or during step `step`.
     #[error(
@@ -174,8 +249,11 @@ pub enum ShellError {
         step.map(|s| format!("step {s}: ")).unwrap_or_default()
     )]
     NonFiniteMaterial {
+        /// the triangle's index
         triangle: usize,
+        /// its strain z = (s_x, s_a, s_y, II_x, II_a, II_y)
         z: [f64; 6],
+        /// the step, `None` in the initial state
         step: Option<usize>,
     },
     /// A quantity of a step is not finite: the simulation diverged and stops (no NaN or infinity is reported as a
@@ -185,9 +263,13 @@ pub enum ShellError {
          loads?)"
     )]
     NonFiniteState {
+        /// the step number
         step: usize,
+        /// the simulated time (s)
         time: f64,
+        /// the quantity that is not finite (e.g. the energy)
         quantity: &'static str,
+        /// its value
         value: f64,
     },
     /// A step that did not converge even at the smallest allowed substep: the run stops (what was written
@@ -198,29 +280,47 @@ pub enum ShellError {
          solver.max_newton or max_halvings, a smaller dt?"
     )]
     StepFailed {
+        /// the step number
         step: usize,
+        /// the simulated time (s)
         time: f64,
+        /// how many times the time step was halved
         halvings: u32,
+        /// the last substep tried (s)
         dt: f64,
+        /// the largest residual force on a free vertex at the end (N)
         residual: f64,
+        /// Newton iterations of the last attempt
         newton: usize,
     },
     /// The Newton matrix of a step could not be factorised at any diagonal shift.
     #[error("step {step}: the Newton system could not be factorised even with a diagonal shift")]
-    Factorization { step: usize },
+    Factorization {
+        /// the step number
+        step: usize,
+    },
     /// The exact Hessian at an equilibrium is not positive definite: it is not a strict minimum and its
     /// sensitivities are undefined (`solver::adjoint`).
     #[error(
         "the exact Hessian at the state (largest residual force {residual:e} N) is not positive definite: \
          not a strict minimum, so its sensitivities are undefined"
     )]
-    NotStrictMinimum { residual: f64 },
+    NotStrictMinimum {
+        /// the largest residual force on a free vertex (N)
+        residual: f64,
+    },
     /// Sensitivities asked for where the adjoint does not apply.
     #[error("sensitivities unavailable: {reason}")]
-    AdjointUnsupported { reason: &'static str },
+    AdjointUnsupported {
+        /// why
+        reason: &'static str,
+    },
     /// A reaction asked for a held set that does not exist.
     #[error("no held set named {set:?} (the handles' names, or `pinned`)")]
-    UnknownHeldSet { set: String },
+    UnknownHeldSet {
+        /// the name asked for
+        set: String,
+    },
 }
 
 impl ShellError {

@@ -48,8 +48,11 @@ impl Interpolation {
 /// JSON: `[t, [x, y, z]]` or `[t, [x, y, z], [vx, vy, vz]]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Keyframe {
+    /// time t (s)
     pub time: f64,
+    /// translation from the initial position (m)
     pub offset: [f64; 3],
+    /// velocity at the key (m/s), Hermite only; `None`: filled in as ARCSim does (zero at the ends, central difference between)
     pub velocity: Option<[f64; 3]>,
 }
 
@@ -111,7 +114,9 @@ impl<'de> Deserialize<'de> for Keyframe {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Motion {
+    /// the keyframes, in increasing time
     pub keyframes: Vec<Keyframe>,
+    /// linear (default) or cubic Hermite between keyframes
     #[serde(default, skip_serializing_if = "Interpolation::is_linear")]
     pub interpolation: Interpolation,
 }
@@ -120,21 +125,47 @@ pub struct Motion {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum MotionError {
     #[error("keyframe {index}: the time {time} is not finite")]
-    Time { index: usize, time: f64 },
+    /// A keyframe time that is not finite.
+    Time {
+        /// the keyframe (0-based)
+        index: usize,
+        /// its time (s)
+        time: f64,
+    },
+    /// Keyframe times that do not increase.
     #[error("keyframe {index}: times must increase, got {time} after {previous}")]
     Order {
+        /// the keyframe (0-based)
         index: usize,
+        /// its time (s)
         time: f64,
+        /// the previous keyframe's time (s)
         previous: f64,
     },
     #[error("keyframe {index}: the translation {offset:?} is not finite")]
-    Offset { index: usize, offset: [f64; 3] },
+    /// A translation that is not finite.
+    Offset {
+        /// the keyframe (0-based)
+        index: usize,
+        /// its translation (m)
+        offset: [f64; 3],
+    },
     #[error("keyframe {index}: the velocity {velocity:?} is not finite")]
-    Velocity { index: usize, velocity: [f64; 3] },
+    /// A velocity that is not finite.
+    Velocity {
+        /// the keyframe (0-based)
+        index: usize,
+        /// its velocity (m/s)
+        velocity: [f64; 3],
+    },
     #[error(
         "keyframe {index} gives a velocity, which only a Hermite motion uses (\"interpolation\": \"hermite\")"
     )]
-    LinearVelocity { index: usize },
+    /// A velocity given in a linear motion.
+    LinearVelocity {
+        /// the keyframe (0-based)
+        index: usize,
+    },
 }
 
 impl Motion {

@@ -28,8 +28,21 @@ use parry3d_f64::shape::{TriMesh, TriMeshFlags};
 /// A rigid obstacle as the solver uses it.
 #[derive(Clone)]
 pub enum Obstacle {
-    Sphere { center: [f64; 3], radius: f64 },
-    Plane { point: [f64; 3], normal: [f64; 3] },
+    /// A sphere.
+    Sphere {
+        /// centre (m)
+        center: [f64; 3],
+        /// radius (m)
+        radius: f64,
+    },
+    /// A half-space bounded by a plane.
+    Plane {
+        /// a point on the plane (m)
+        point: [f64; 3],
+        /// the outward normal (the cloth's side)
+        normal: [f64; 3],
+    },
+    /// A closed triangle mesh.
     Mesh(Box<MeshObstacle>),
 }
 
@@ -48,7 +61,9 @@ impl std::fmt::Debug for Obstacle {
 pub struct MeshObstacle {
     /// where it came from (for messages)
     pub name: String,
+    /// vertex positions (m)
     pub vertices: Vec<[f64; 3]>,
+    /// triangles (vertex indices, outward orientation)
     pub triangles: Vec<[usize; 3]>,
     trimesh: TriMesh,
 }
@@ -165,21 +180,47 @@ impl MeshObstacle {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Feature {
     /// a sphere: d = |p − centre| − radius
-    Sphere { center: [f64; 3], radius: f64 },
+    Sphere {
+        /// centre (m)
+        center: [f64; 3],
+        /// radius (m)
+        radius: f64,
+    },
     /// a plane or the inside of a mesh face: d = n·(p − a)
-    Face { a: [f64; 3], n: [f64; 3] },
+    Face {
+        /// a point of the face (m)
+        a: [f64; 3],
+        /// the unit outward normal
+        n: [f64; 3],
+    },
     /// a mesh edge: d = ±dist(p, line ab)
-    Edge { a: [f64; 3], b: [f64; 3], sign: f64 },
+    Edge {
+        /// one end of the edge (m)
+        a: [f64; 3],
+        /// the other end (m)
+        b: [f64; 3],
+        /// +1 outside, −1 inside
+        sign: f64,
+    },
     /// a mesh vertex: d = ±|p − a|
-    Vertex { a: [f64; 3], sign: f64 },
+    Vertex {
+        /// the vertex (m)
+        a: [f64; 3],
+        /// +1 outside, −1 inside
+        sign: f64,
+    },
 }
 
 /// Signed distance, its gradient (unit normal) and its Hessian at a point, and the feature they come from.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Proximity {
+    /// signed distance d (m; negative inside)
     pub d: f64,
+    /// its gradient ∇d, the unit normal
     pub n: [f64; 3],
+    /// its Hessian ∇²d (1/m)
     pub hess: [[f64; 3]; 3],
+    /// the closest feature
     pub feature: Feature,
 }
 
@@ -401,7 +442,9 @@ pub fn penalty_hessian_exact(pr: &Proximity, m: f64, k: f64, delta: f64) -> [[f6
 /// A vertex in contact at the start of a step: the frozen normal n and normal force λ of lagged friction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrictionContact {
+    /// the vertex
     pub vertex: usize,
+    /// the frozen unit normal n
     pub n: [f64; 3],
     /// normal force magnitude λ = m k p² (N)
     pub lambda: f64,

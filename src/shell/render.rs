@@ -13,7 +13,9 @@ pub struct View {
     pub azimuth_deg: f64,
     /// angle of the viewing direction above the horizontal plane (degrees)
     pub elevation_deg: f64,
+    /// image width (pixels)
     pub width: u32,
+    /// image height (pixels)
     pub height: u32,
 }
 
@@ -30,8 +32,11 @@ impl Default for View {
 
 /// One triangle mesh to draw in one colour.
 pub struct Layer<'a> {
+    /// vertex positions (m)
     pub positions: &'a [[f64; 3]],
+    /// triangles (vertex indices)
     pub triangles: &'a [[usize; 3]],
+    /// fill colour (RGB)
     pub color: [u8; 3],
 }
 

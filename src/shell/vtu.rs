@@ -14,8 +14,11 @@ use std::path::Path;
 
 /// A named field with `components` numbers per triangle (cell data) or per vertex (point data).
 pub struct CellField<'a> {
+    /// the field's name
     pub name: &'a str,
+    /// numbers per cell or point
     pub components: usize,
+    /// the numbers, `components` per cell or point
     pub values: &'a [f64],
 }
 

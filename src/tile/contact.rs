@@ -13,8 +13,11 @@ use rayon::prelude::*;
 /// offset `image`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ContactPair {
+    /// the home segment (its start vertex)
     pub a: usize,
+    /// the other segment (its start vertex)
     pub b: usize,
+    /// the periodic offset of `b`'s image
     pub image: [i32; 2],
 }
 

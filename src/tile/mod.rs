@@ -23,21 +23,29 @@ use rayon::prelude::*;
 /// What an evaluation computes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Want {
+    /// The energy only.
     Value,
+    /// The energy and its gradient.
     Gradient,
+    /// The energy, its gradient and its Hessian.
     Hessian,
 }
 
 /// The energy of each part of the model.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct EnergyParts {
+    /// Stretching energy (J).
     pub stretch: f64,
+    /// Bending energy (J).
     pub bend: f64,
+    /// Twisting energy (J).
     pub twist: f64,
+    /// Contact energy (J).
     pub contact: f64,
 }
 
 impl EnergyParts {
+    /// The total energy E (J): the sum of the parts.
     pub fn total(&self) -> f64 {
         self.stretch + self.bend + self.twist + self.contact
     }
@@ -47,19 +55,25 @@ impl EnergyParts {
 /// evaluates the terms one at a time to get ∂∇E/∂parameter).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Terms {
+    /// Weight of the stretching term.
     pub stretch: f64,
+    /// Weight of the bending term.
     pub bend: f64,
+    /// Weight of the twisting term.
     pub twist: f64,
+    /// Weight of the contact term.
     pub contact: f64,
 }
 
 impl Terms {
+    /// Every term at weight 1: the physical energy.
     pub const ALL: Terms = Terms {
         stretch: 1.0,
         bend: 1.0,
         twist: 1.0,
         contact: 1.0,
     };
+    /// The rod terms only (no contact).
     pub const RODS: Terms = Terms {
         stretch: 1.0,
         bend: 1.0,
@@ -72,12 +86,16 @@ impl Terms {
 /// consumer) of the tile.
 #[derive(Clone, Debug)]
 pub struct TileEval {
+    /// The energy of each part (J).
     pub parts: EnergyParts,
+    /// ∇E over the dofs (positions in N, angles in N·m), with [`Want::Gradient`] or [`Want::Hessian`].
     pub gradient: Option<DVector<f64>>,
+    /// ∇²E as (row, column, value) triplets, duplicates to be summed, with [`Want::Hessian`].
     pub hessian: Option<Vec<(usize, usize, f64)>>,
 }
 
 impl TileEval {
+    /// The total energy E (J).
     pub fn value(&self) -> f64 {
         self.parts.total()
     }
@@ -111,7 +129,9 @@ impl TileEval {
 /// Without a map the dofs are the home positions themselves.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DofMap {
+    /// b_v = φ(ξ_v) + h_v n(ξ_v) per vertex (m).
     pub base: Vec<Vector3<f64>>,
+    /// R_v = R(ξ_v) per vertex.
     pub rotation: Vec<Matrix3<f64>>,
 }
 
@@ -122,14 +142,19 @@ pub type OffsetResultant = ([i32; 2], Vector3<f64>, Vector3<f64>);
 /// A periodic tile ready to evaluate: the pattern's rest values, the material, the rod topology and the contact
 /// pairs.
 pub struct Tile<'a> {
+    /// The pattern (rest values and stored state).
     pub pattern: &'a Pattern,
+    /// The yarn material (radius the pattern's).
     pub material: YarnMaterial,
+    /// The bending stencil of every vertex.
     pub topology: RodTopology,
+    /// The Voronoi length of each vertex along its yarn (m).
     pub voronoi: Vec<f64>,
     /// The rigid transforms of the periodic copies.
     pub placement: TileTransforms,
     /// The per-vertex dof map (none: dofs are world positions).
     pub dof_map: Option<DofMap>,
+    /// The contact pairs (segment against segment, with the image offset).
     pub contacts: Vec<ContactPair>,
     /// Radius of the contact distance 2r: the yarn radius times the material's contact radius factor.
     pub contact_radius: f64,

@@ -23,8 +23,11 @@ use nalgebra::{DMatrix, DVector};
 /// (contact distance 2·factor·r).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactForm {
+    /// Gauss–Legendre points per segment Q of the contact quadrature.
     pub quadrature: usize,
+    /// Neighbouring segments on each side along the same yarn that never touch.
     pub exclusion: usize,
+    /// Contact radius factor f (contact distance 2 f r).
     pub radius_factor: f64,
 }
 
@@ -42,9 +45,13 @@ impl Default for ContactForm {
 /// respect to r·θ).
 #[derive(Clone, Debug)]
 pub struct GradientParts {
+    /// a_s: gradient of the stretching term per unit Y.
     pub stretch: DVector<f64>,
+    /// a_b: gradient of the bending term per unit γY.
     pub bend: DVector<f64>,
+    /// a_t: gradient of the twisting term per unit γG.
     pub twist: DVector<f64>,
+    /// a_c: gradient of the contact term per unit k_c.
     pub contact: DVector<f64>,
     /// Number of position rows (the rest are angle rows).
     pub n_positions: usize,
@@ -107,6 +114,7 @@ pub fn gradient_parts(
 /// Stiffness parameters of a calibration (Y fixed by the caller).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Stiffness {
+    /// Young's modulus Y (Pa).
     pub young: f64,
     /// γY
     pub bend: f64,
@@ -126,9 +134,11 @@ impl Stiffness {
             contact: m.contact_stiffness,
         }
     }
+    /// The bending-twisting factor γ = (γY) / Y.
     pub fn gamma(&self) -> f64 {
         self.bend / self.young
     }
+    /// The ratio G/Y = (γG) / (γY).
     pub fn shear_over_young(&self) -> f64 {
         self.twist / self.bend
     }
@@ -221,9 +231,13 @@ pub fn fit(parts: &[&GradientParts], young: f64, use_contact: bool) -> Stiffness
 /// One row of the calibration table: a pattern under one contact form.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct CalibrationRow {
+    /// The pattern's name.
     pub pattern: String,
+    /// Gauss–Legendre points per segment Q of the contact quadrature.
     pub quadrature: usize,
+    /// Contact exclusion along the yarn (segments on each side).
     pub exclusion: usize,
+    /// Contact radius factor f.
     pub radius_factor: f64,
     /// Contact pairs with non-zero energy at the stored state.
     pub active_pairs: usize,
@@ -235,8 +249,11 @@ pub struct CalibrationRow {
     pub residual_joint: f64,
     /// The best parameters for this pattern alone (Y fixed) and the residual they reach.
     pub own_gamma: f64,
+    /// The best G/Y for this pattern alone.
     pub own_shear_over_young: f64,
+    /// The best k_c (J/m²) for this pattern alone.
     pub own_contact_stiffness: f64,
+    /// The residual ‖∇E‖/‖∇E_rods‖ those reach.
     pub residual_own: f64,
     /// The best residual without contact (k_c = 0).
     pub residual_own_no_contact: f64,
@@ -245,13 +262,21 @@ pub struct CalibrationRow {
 /// The joint calibration over a set of patterns and the per-pattern rows.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Calibration {
+    /// Gauss–Legendre points per segment Q of the contact quadrature.
     pub quadrature: usize,
+    /// Contact exclusion along the yarn (segments on each side).
     pub exclusion: usize,
+    /// Contact radius factor f.
     pub radius_factor: f64,
+    /// Young's modulus Y (Pa), fixed.
     pub young: f64,
+    /// The jointly fitted factor γ.
     pub gamma: f64,
+    /// The jointly fitted G/Y.
     pub shear_over_young: f64,
+    /// The jointly fitted contact stiffness k_c (J/m²).
     pub contact_stiffness: f64,
+    /// One row per reported pattern.
     pub rows: Vec<CalibrationRow>,
 }
 

@@ -60,10 +60,15 @@ pub fn read_json(path: &Path) -> Result<Value, ValidationError> {
 /// cases beyond the given tolerances.
 #[derive(Clone, Debug, Serialize)]
 pub struct Conformance {
+    /// the checked quantity's name
     pub name: String,
+    /// oracle cases compared
     pub cases: usize,
+    /// largest relative error of the value
     pub value: f64,
+    /// largest relative error of the first derivatives
     pub first: f64,
+    /// largest relative error of the second derivatives
     pub second: f64,
     /// one line per case beyond the tolerances
     pub failures: Vec<String>,

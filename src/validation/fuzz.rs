@@ -34,14 +34,20 @@ pub const HUGE_LINE: usize = 100_000;
 /// The input formats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
+    /// Pattern files (`.pyp`).
     Pyp,
+    /// Material JSON files.
     Material,
+    /// Sampling plan JSON files.
     Plan,
+    /// Scene JSON files.
     Scene,
+    /// Sample files (JSON lines).
     Samples,
 }
 
 impl Format {
+    /// Every format.
     pub const ALL: [Format; 5] = [
         Format::Pyp,
         Format::Material,
@@ -50,6 +56,7 @@ impl Format {
         Format::Samples,
     ];
 
+    /// The format's name (`pyp`, `material`, `plan`, `scene`, `samples`).
     pub fn name(self) -> &'static str {
         match self {
             Format::Pyp => "pyp",
@@ -64,17 +71,26 @@ impl Format {
 /// One mutation of a text.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mutation {
+    /// Cut the text at a random byte.
     Truncate,
+    /// Delete a random line.
     DeleteLine,
+    /// Duplicate a random line.
     DuplicateLine,
+    /// Replace one number by one of [`EXTREME_NUMBERS`].
     ReplaceNumber,
+    /// Prepend a UTF-8 byte-order mark.
     ByteOrderMark,
+    /// Turn every line end into CR LF.
     Crlf,
+    /// Insert 1–63 random bytes at a random place.
     Garbage,
+    /// Insert a run of up to [`HUGE_LINE`] `9`s or `x`s at a random place.
     HugeLine,
 }
 
 impl Mutation {
+    /// Every mutation.
     pub const ALL: [Mutation; 8] = [
         Mutation::Truncate,
         Mutation::DeleteLine,
@@ -194,13 +210,19 @@ pub enum Outcome {
 /// The counts of a run over one format, with the first few failures.
 #[derive(Clone, Debug, Default)]
 pub struct FuzzReport {
+    /// Cases run.
     pub cases: usize,
+    /// Cases parsed with finite evaluations ([`Outcome::Accepted`]).
     pub accepted: usize,
+    /// Cases rejected with a typed error.
     pub rejected: usize,
+    /// Cases with a non-finite evaluation.
     pub non_finite: usize,
+    /// Cases that panicked.
     pub panics: usize,
     /// Cases longer than [`CASE_BUDGET`].
     pub slow: usize,
+    /// The longest wall time of a case.
     pub longest: Duration,
     /// (case, mutations, what happened) of the first failures.
     pub failures: Vec<(usize, Vec<Mutation>, String)>,

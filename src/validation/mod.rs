@@ -22,19 +22,31 @@ use std::path::PathBuf;
 /// Reading the original data failed: the file, and what is wrong with it.
 #[derive(Debug, thiserror::Error)]
 pub enum ValidationError {
+    /// A file could not be read.
     #[error("{}: cannot read: {source}", path.display())]
     Read {
+        /// The file.
         path: PathBuf,
+        /// The I/O error.
         source: std::io::Error,
     },
+    /// A file is not the JSON it should be.
     #[error("{}: {source}", path.display())]
     Json {
+        /// The file.
         path: PathBuf,
+        /// The parser's error.
         source: serde_json::Error,
     },
     /// The file was read but its content is not what it should be.
     #[error("{}: {message}", path.display())]
-    Data { path: PathBuf, message: String },
+    Data {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// A material file of the original data could not be used.
     #[error(transparent)]
     Material(#[from] crate::material::MaterialError),
 }

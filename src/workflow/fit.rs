@@ -32,6 +32,7 @@ pub struct FitJob {
     pub holdout: Vec<PathBuf>,
     /// Another material to compare the fitted 1D curves with.
     pub compare: Option<PathBuf>,
+    /// The fit's options.
     pub options: FitOptions,
     /// Write the plots.
     pub write_plots: bool,

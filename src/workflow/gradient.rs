@@ -35,6 +35,7 @@ pub struct GradientOptions {
     /// also central differences of re-solves for the scene's scalars, the boundary's positions and the
     /// `check_coefficients` material coefficients with the largest |c dJ/dc|
     pub check: bool,
+    /// how many material coefficients the check re-solves for (those with the largest |c dJ/dc|)
     pub check_coefficients: usize,
     /// also dJ/dθ for the yarn parameters through the samples the material was fitted to
     /// ([`super::yarn_chain`])
@@ -44,7 +45,9 @@ pub struct GradientOptions {
 /// The samples (made with `--sensitivities`) and yarn parameters of the yarn chain.
 #[derive(Clone, Debug)]
 pub struct YarnChainInput {
+    /// the sample file (made with `--sensitivities`)
     pub samples: std::path::PathBuf,
+    /// the yarn parameters the samples were made with
     pub yarn: crate::rod::YarnMaterial,
     /// how the yarn parameters are named in messages (their file)
     pub yarn_label: String,
@@ -53,8 +56,11 @@ pub struct YarnChainInput {
 /// One row of the finite-difference check.
 #[derive(Clone, Debug)]
 pub struct CheckRow {
+    /// the parameter's name
     pub parameter: String,
+    /// dJ/dp by the adjoint
     pub adjoint: f64,
+    /// dJ/dp by central differences of re-solves
     pub difference: f64,
     /// |adjoint − difference| / max(|difference|, 1e-6 scale): the scale is the largest |p dJ/dp| checked
     pub error: f64,
@@ -62,15 +68,19 @@ pub struct CheckRow {
 
 /// The gradient, its JSON (`gradient.json`) and the check.
 pub struct GradientOutcome {
+    /// dJ/dp for the scene's parameters, the boundary and the material coefficients
     pub sensitivity: Sensitivity,
     /// dJ/dθ, with [`GradientOptions::yarn`]
     pub yarn: Option<YarnGradient>,
     /// the time of the equilibrium (s)
     pub time: f64,
+    /// the content of `gradient.json`
     pub json: Value,
+    /// the finite-difference check's rows (empty without [`GradientOptions::check`])
     pub check: Vec<CheckRow>,
     /// wall time of the forward solve and of the gradient (s)
     pub wall_forward: f64,
+    /// wall time of the gradient (s)
     pub wall_gradient: f64,
 }
 

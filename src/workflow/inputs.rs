@@ -12,6 +12,7 @@ use std::path::Path;
 
 /// A loaded pattern, with the periods its file stored when they disagreed with its rest lengths.
 pub struct LoadedPattern {
+    /// The pattern (with the implied periods when the file's disagreed).
     pub pattern: Pattern,
     /// The file's periods, replaced by the implied ones (`None` when they agreed or the pattern is generated).
     pub replaced_periods: Option<[f64; 2]>,

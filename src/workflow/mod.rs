@@ -46,13 +46,23 @@ pub enum Event<'a> {
     /// A note or warning (the binary writes it to stderr).
     Note(&'a str),
     /// A sample was written: `done` of the `todo` samples this sampling run writes.
-    Samples { done: usize, todo: usize },
+    Samples {
+        /// samples written so far
+        done: usize,
+        /// samples this run writes
+        todo: usize,
+    },
     /// A cloth time step finished: `done` of `total` steps, simulated time, Newton iterations, final residual.
     Step {
+        /// steps finished
         done: usize,
+        /// steps in all
         total: usize,
+        /// simulated time (s)
         time: f64,
+        /// Newton iterations of the step
         newton: usize,
+        /// largest residual force on a free vertex at the end of the step (N)
         residual: f64,
     },
 }
@@ -63,32 +73,45 @@ pub enum WorkflowError {
     /// A file or folder operation failed.
     #[error("{}: {action}: {source}", path.display())]
     Io {
+        /// the file or folder
         path: PathBuf,
+        /// what was being done ("cannot read", …)
         action: &'static str,
+        /// the I/O error
         source: std::io::Error,
     },
+    /// A pattern file could not be read or used.
     #[error(transparent)]
     Pattern(#[from] crate::pattern::PatternError),
+    /// A pattern could not be generated.
     #[error(transparent)]
     Generate(#[from] crate::generate::GenerateError),
+    /// A sampling plan could not be read or used.
     #[error(transparent)]
     Plan(#[from] crate::sample::plan::PlanError),
+    /// A material file could not be read or used.
     #[error(transparent)]
     Material(#[from] crate::material::json::MaterialError),
+    /// A cloth scene failed.
     #[error(transparent)]
     Shell(#[from] crate::shell::ShellError),
+    /// Sampling failed.
     #[error(transparent)]
     Sample(#[from] crate::sample::SampleError),
     /// The reference state (C1) of a pattern failed.
     #[error("{pattern}: reference state: {source}")]
     Reference {
+        /// the pattern's name
         pattern: String,
+        /// the reference state's error
         source: crate::micro::reference::ReferenceError,
     },
     /// The fit (C5) of a sample file failed.
     #[error("{}: {source}", samples.display())]
     Fit {
+        /// the sample file
         samples: PathBuf,
+        /// the fit's error
         source: crate::fit::FitError,
     },
     /// Bad input to a workflow, with the argument or file at fault.

@@ -12,7 +12,9 @@ use std::path::{Path, PathBuf};
 pub struct Overrides {
     /// A material file (relative to the working directory) or `default`.
     pub material: Option<String>,
+    /// The scene's duration (s).
     pub duration: Option<f64>,
+    /// The scene's time step (s).
     pub dt: Option<f64>,
     /// `solver.time_tol`: the largest estimated local error of a substep, or off.
     pub time_tol: Option<TimeTol>,
@@ -22,9 +24,13 @@ pub struct Overrides {
     pub substeps: Option<u32>,
     /// The edge length of a rectangle mesh.
     pub edge: Option<f64>,
+    /// The PSD option of the element Hessians.
     pub psd: Option<Psd>,
+    /// Turn bending off (`model.bending = false`).
     pub no_bending: bool,
+    /// Keep only the 1D terms of ψ (`model.only_1d`).
     pub only_1d: bool,
+    /// Keep only the in-plane terms of ψ (`model.in_plane_only`).
     pub in_plane_only: bool,
     /// also a `.vtu` frame (ψ and the strain per triangle) beside each OBJ, `output.vtu`
     pub vtu: bool,
@@ -34,7 +40,9 @@ pub struct Overrides {
 /// error, at most `Metres(τ)`, or `Off` (they shorten only when Newton fails). Read from `off` or a length.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum TimeTol {
+    /// No tolerance: substeps shorten only when Newton fails.
     Off,
+    /// The largest estimated local error of a substep (m).
     Metres(f64),
 }
 
@@ -142,8 +150,11 @@ pub fn prepare_noted(
 
 /// The end state of a simulation: its summary, the final positions and the triangles.
 pub struct Outcome {
+    /// the run's summary
     pub summary: RunSummary,
+    /// the final vertex positions (m)
     pub positions: Vec<[f64; 3]>,
+    /// the mesh's triangles
     pub triangles: Vec<[usize; 3]>,
     /// the obstacles' surfaces (spheres and meshes; planes have none), for pictures
     pub obstacles: Vec<crate::shell::mesh::Surface>,

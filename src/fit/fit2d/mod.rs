@@ -109,6 +109,7 @@ impl Default for Fit2DOptions {
 /// Fit quality of the unconverted spline f at the samples it was fitted to.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Fit2DReport {
+    /// samples used
     pub n_samples: usize,
     /// samples excluded because a coordinate or Ψ is not finite (failed solves)
     pub n_excluded: usize,
@@ -118,6 +119,7 @@ pub struct Fit2DReport {
     pub max_rel: f64,
     /// minimum knot (i_min along u, j_min along v)
     pub i_min: usize,
+    /// (j_min along v)
     pub j_min: usize,
     /// rounds of twist halving that step 5 needed
     pub twist_rounds: usize,
@@ -132,8 +134,11 @@ pub struct Fit2DReport {
 /// A fitted 2D term: the residual spline the material uses, the unconverted spline f, and the report.
 #[derive(Clone, Debug)]
 pub struct Fit2D {
+    /// the residual r(u, v) = f(u, v) − f(u, 0) − f(0, v) + f(0, 0) after steps 6–8, which the material uses
     pub residual: Hermite2D,
+    /// the unconverted spline f of step 5
     pub full: Hermite2D,
+    /// the fit's report
     pub report: Fit2DReport,
 }
 

@@ -46,6 +46,7 @@ pub enum PatternWarning {
 /// The numbers behind [`PatternWarning::PeriodMismatch`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct PeriodMismatch {
+    /// the pattern file
     pub file: String,
     /// The stored periods (m).
     pub stored: [f64; 2],

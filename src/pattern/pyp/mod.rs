@@ -153,6 +153,7 @@ pub struct PatternError {
     pub block: Option<String>,
     /// 1-based line number.
     pub line: Option<usize>,
+    /// What is wrong.
     pub message: String,
 }
 

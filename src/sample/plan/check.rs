@@ -78,8 +78,11 @@ fn parse_pairs(names: Vec<[String; 2]>) -> Result<Vec<[StrainComponent; 2]>, (St
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("{}plan field {field}: {message}", file.as_ref().map_or(String::new(), |f| format!("{f}: ")))]
 pub struct PlanError {
+    /// the plan file, if the plan came from one
     pub file: Option<String>,
+    /// the field at fault
     pub field: String,
+    /// what is wrong
     pub message: String,
 }
 

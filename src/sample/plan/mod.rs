@@ -55,11 +55,16 @@ pub fn sample_range(k: usize, z_min: f64, z_max: f64, n: usize) -> Vec<f64> {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Ranges {
+    /// range of s_x
     pub s_x: [f64; 2],
+    /// range of s_a
     pub s_a: [f64; 2],
+    /// range of s_y
     pub s_y: [f64; 2],
+    /// range of Π₀₀ (1/m)
     #[serde(rename = "II00")]
     pub ii00: [f64; 2],
+    /// range of Π₁₁ (1/m)
     #[serde(rename = "II11")]
     pub ii11: [f64; 2],
 }
@@ -118,8 +123,11 @@ pub struct Plan {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InPlaneGrid {
+    /// values of s_x
     pub s_x: Vec<f64>,
+    /// values of s_a
     pub s_a: Vec<f64>,
+    /// values of s_y
     pub s_y: Vec<f64>,
 }
 
@@ -207,7 +215,9 @@ pub struct Sample {
 /// chain (the reference state when `None`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Step {
+    /// the sample to solve (its index in the plan)
     pub sample: usize,
+    /// the earlier step of the chain it starts from (`None`: the reference state)
     pub from: Option<usize>,
 }
 
@@ -215,6 +225,7 @@ pub struct Step {
 /// sequentially and its results depend only on the chain.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Chain {
+    /// the steps in solve order
     pub steps: Vec<Step>,
 }
 

@@ -17,8 +17,11 @@ use Key::{Ignored, Used};
 /// `wind.density` 1, `magic.handle_stiffness` 1e3 N/m, `magic.repulsion_thickness` 1e-3 m, `obs_friction` 0.3,
 /// `gravity` zero, `frame_steps` 1.
 pub const DEFAULT_WIND_DENSITY: f64 = 1.0;
+/// ARCSim's `magic.handle_stiffness` (N/m).
 pub const DEFAULT_HANDLE_STIFFNESS: f64 = 1e3;
+/// ARCSim's `magic.repulsion_thickness` (m).
 pub const DEFAULT_REPULSION_THICKNESS: f64 = 1e-3;
+/// ARCSim's `obs_friction` (Coulomb coefficient μ).
 pub const DEFAULT_OBS_FRICTION: f64 = 0.3;
 
 /// The converted scene's `solver.time_tol` (m): implicit Euler with substeps chosen by their estimated error.

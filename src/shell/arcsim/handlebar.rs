@@ -13,9 +13,13 @@ pub const SIDES: [&str; 4] = ["left", "bottom", "right", "top"];
 /// A handlebar's geometry: `side` 0–3 and the fractions `lengthp`, `widthp`, `insetp` of the cloth's extents.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Handlebar {
+    /// the side: 0 left, 1 bottom, 2 right, 3 top
     pub side: usize,
+    /// fraction of the extent along the side the strip covers (its middle part)
     pub lengthp: f64,
+    /// width of the strip across the side, as a fraction of the extent
     pub widthp: f64,
+    /// distance of the strip's centre line from the side, as a fraction of the extent
     pub insetp: f64,
 }
 

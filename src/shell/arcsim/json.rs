@@ -8,18 +8,26 @@ use std::fmt;
 /// A parsed value with the (1-based) line it starts on.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Node {
+    /// the line it starts on (1-based)
     pub line: usize,
+    /// the value
     pub value: Value,
 }
 
 /// A JSON value; objects keep their keys in file order (a repeated key appears twice).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Value {
+    /// `null`.
     Null,
+    /// `true` or `false`.
     Bool(bool),
+    /// A number (`NaN`, `Infinity` and `-Infinity` included).
     Number(f64),
+    /// A string.
     String(String),
+    /// An array.
     Array(Vec<Node>),
+    /// An object: its keys and values in file order.
     Object(Vec<(String, Node)>),
 }
 
@@ -40,8 +48,11 @@ impl Value {
 /// A syntax error at a line and column (1-based; the column counts characters).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SyntaxError {
+    /// line (1-based)
     pub line: usize,
+    /// column (1-based, in characters)
     pub column: usize,
+    /// what is wrong
     pub message: String,
 }
 

@@ -47,8 +47,11 @@ use std::path::{Path, PathBuf};
 /// link file followed).
 #[derive(Clone, Debug)]
 pub struct Converted {
+    /// the scene
     pub scene: Scene,
+    /// keys ignored or unknown, one line each (file, line, key)
     pub warnings: Vec<String>,
+    /// what the conversion did that is worth knowing, one line each
     pub notes: Vec<String>,
 }
 

@@ -7,6 +7,7 @@ pub const BUILTINS: [&str; 5] = ["stretch-x", "stretch-y", "drape-x", "drape-y",
 
 /// Side of the built-in squares (m) and their default edge length: 51 × 51 cells, 5 202 triangles.
 pub const SIDE: f64 = 0.3;
+/// The built-ins' default edge length (m): [`SIDE`] / 51.
 pub const BUILTIN_EDGE: f64 = 0.3 / 51.0;
 
 /// A built-in scene matching the original's tests (30 × 30 cm, 1 s at 1/60 s steps, PSD option `psi`):

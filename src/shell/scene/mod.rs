@@ -83,61 +83,92 @@ fn default_seed() -> u64 {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
+    /// a label for the scene (the built-ins and converted ARCSim scenes carry their names); empty by default
     #[serde(default)]
     pub name: String,
+    /// `"default"` (the built-in synthetic material) or a material JSON path, relative to the scene file
     pub material: String,
+    /// the cloth mesh: a generated rectangle or an OBJ file
     pub mesh: MeshSpec,
+    /// where a rectangle's rest layout is put in space (x = origin + X u + Y v)
     #[serde(default)]
     pub placement: Placement,
+    /// angle (degrees) of the fabric x axis (the warp) against the mesh x axis
     #[serde(default)]
     pub fabric_angle_deg: f64,
+    /// simulated time (s); the scene takes ⌈duration / dt⌉ steps ([`Scene::steps`])
     pub duration: f64,
+    /// time step h (s); 1/60 by default
     #[serde(default = "default_dt")]
     pub dt: f64,
+    /// minimise E − f·x per step instead of the incremental potential (no inertia)
     #[serde(default)]
     pub quasi_static: bool,
+    /// gravitational acceleration g (m/s²); (0, 0, −9.81) by default
     #[serde(default = "default_gravity")]
     pub gravity: [f64; 3],
+    /// linear drag rate c (1/s)
     #[serde(default)]
     pub drag: f64,
+    /// stiffness-proportional damping coefficient c (s)
     #[serde(default)]
     pub damping: f64,
+    /// air drag (ARCSim's wind); none by default
     #[serde(default)]
     pub wind: Wind,
+    /// `None`: pins and handles are hard constraints; `Some(k)`: each held vertex is a spring ½ k |x − target|² (k in N/m)
     #[serde(default)]
     pub handle_stiffness: Option<f64>,
+    /// which parts of ψ the elements evaluate, and the stiffness and mass multipliers
     #[serde(default)]
     pub model: ModelSpec,
+    /// how the element Hessians are made positive semi-definite (`"full"`, `"psi"`, `"none"`)
     #[serde(default = "default_psd")]
     pub psd: Psd,
+    /// Newton and time-stepping settings
     #[serde(default)]
     pub solver: SolverSpec,
+    /// vertices held fixed at their initial positions (reported as `pin0`, `pin1`, …)
     #[serde(default)]
     pub pins: Vec<Selection>,
+    /// named vertex groups following keyframed translations
     #[serde(default)]
     pub handles: Vec<HandleSpec>,
+    /// spheres, planes and meshes the cloth collides with
     #[serde(default)]
     pub obstacles: Vec<ObstacleSpec>,
+    /// obstacle contact layer, penalty and friction
     #[serde(default)]
     pub contact: ContactSpec,
+    /// which files the runner writes per frame
     #[serde(default)]
     pub output: OutputSpec,
 }
 
+/// The cloth mesh of a scene file: a generated rectangle or an OBJ file (`"rectangle"` / `"obj"`).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(rename_all = "lowercase", deny_unknown_fields)]
 pub enum MeshSpec {
+    /// A `width` × `height` rectangle with corner (0, 0), split into squares of alternating diagonals.
     Rectangle {
+        /// extent along x (m)
         width: f64,
+        /// extent along y (m)
         height: f64,
+        /// target edge length (m): the cell size is about this
         edge: f64,
+        /// random displacement of the vertices, as a fraction of the cell size (< 0.5; 0: none; boundary vertices move along their side)
         #[serde(default)]
         perturb: f64,
+        /// seed of the perturbation
         #[serde(default = "default_seed")]
         seed: u64,
     },
+    /// A Wavefront OBJ surface; its (scaled) flat layout is the rest state.
     Obj {
+        /// the OBJ file, relative to the scene file
         path: String,
+        /// the placement of the initial state (the rest layout is the scaled OBJ)
         #[serde(default, skip_serializing_if = "Transform::is_identity")]
         transform: Transform,
     },
@@ -148,8 +179,11 @@ pub enum MeshSpec {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct Transform {
+    /// uniform scale s
     pub scale: f64,
+    /// translation t (m)
     pub translate: [f64; 3],
+    /// rotation: [angle in degrees, axis x, y, z]
     pub rotate: [f64; 4],
 }
 
@@ -164,6 +198,7 @@ impl Default for Transform {
 }
 
 impl Transform {
+    /// Whether this is the default transform (scale 1, no translation, no rotation).
     pub fn is_identity(&self) -> bool {
         *self == Transform::default()
     }
@@ -197,22 +232,34 @@ impl Transform {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(rename_all = "lowercase", deny_unknown_fields)]
 pub enum ObstacleSpec {
+    /// A sphere.
     Sphere {
+        /// centre (m)
         center: [f64; 3],
+        /// radius (m)
         radius: f64,
+        /// its translation over time (none: fixed)
         #[serde(default, skip_serializing_if = "Option::is_none")]
         motion: Option<Motion>,
     },
+    /// A half-space bounded by a plane.
     Plane {
+        /// a point on the plane (m)
         point: [f64; 3],
+        /// the outward normal (the cloth stays on its side)
         normal: [f64; 3],
+        /// its translation over time (none: fixed)
         #[serde(default, skip_serializing_if = "Option::is_none")]
         motion: Option<Motion>,
     },
+    /// A triangle mesh read from an OBJ file.
     Mesh {
+        /// the OBJ file, relative to the scene file
         path: String,
+        /// its placement
         #[serde(default, skip_serializing_if = "Transform::is_identity")]
         transform: Transform,
+        /// its translation over time (none: fixed)
         #[serde(default, skip_serializing_if = "Option::is_none")]
         motion: Option<Motion>,
     },
@@ -229,11 +276,15 @@ impl ObstacleSpec {
     }
 }
 
+/// The placement of a rectangle's rest layout in space: x = origin + X u + Y v.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct Placement {
+    /// position of the rest-layout origin (m)
     pub origin: [f64; 3],
+    /// image of the rest-layout x axis
     pub u: [f64; 3],
+    /// image of the rest-layout y axis
     pub v: [f64; 3],
 }
 
@@ -251,16 +302,22 @@ impl Default for Placement {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
+    /// evaluate the bending strains (hinges); false: II ≡ 0
     #[serde(default = "yes")]
     pub bending: bool,
+    /// keep only the 1D terms of ψ (the original's `only1D`)
     #[serde(default)]
     pub only_1d: bool,
+    /// keep only the in-plane terms of ψ; implies no bending
     #[serde(default)]
     pub in_plane_only: bool,
+    /// stiffness multiplier k of ψ
     #[serde(default = "one")]
     pub stiffness: f64,
+    /// bending scale β (multiplies II before ψ)
     #[serde(default = "one")]
     pub bending_scale: f64,
+    /// multiplier of every lumped vertex mass (1: the material's areal density)
     #[serde(default = "one")]
     pub mass: f64,
     /// the fold barrier ([`FoldBarrier`]); on by default, `null` turns it off
@@ -294,11 +351,15 @@ impl Default for ModelSpec {
     }
 }
 
+/// Newton and time-stepping settings of a scene file (defaults those of [`Settings`]).
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverSpec {
+    /// convergence: largest residual force on a free vertex (N)
     pub force_tol: f64,
+    /// Newton iterations per step at most
     pub max_newton: usize,
+    /// try the exact Hessian first and fall back to the PSD option's Hessian only when its factorisation fails
     pub exact_first: bool,
     /// a step whose Newton iterations do not converge is retried with the time step halved, at most this many
     /// times (6: down to 1/64 of it)
@@ -338,10 +399,13 @@ impl Default for SolverSpec {
     }
 }
 
+/// Obstacle contact of a scene file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
+    /// obstacle layer thickness δ (m)
     pub thickness: f64,
+    /// obstacle penalty k (1/(m·s²)): E = m k p³/3, p the penetration of the layer
     pub stiffness: f64,
     /// Coulomb friction coefficient μ against obstacles (lagged friction)
     #[serde(default)]
@@ -367,6 +431,7 @@ impl Default for ContactSpec {
     }
 }
 
+/// The runner's per-frame output of a scene file.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
@@ -390,9 +455,28 @@ impl Default for OutputSpec {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(rename_all = "lowercase", deny_unknown_fields)]
 pub enum Selection {
-    Box { min: [f64; 2], max: [f64; 2] },
-    Near { point: [f64; 2], radius: f64 },
-    Ball { center: [f64; 3], radius: f64 },
+    /// The vertices inside an axis-aligned box of the rest layout.
+    Box {
+        /// lower corner (m)
+        min: [f64; 2],
+        /// upper corner (m)
+        max: [f64; 2],
+    },
+    /// The vertices within `radius` of a rest-layout point.
+    Near {
+        /// the point (m)
+        point: [f64; 2],
+        /// the radius (m)
+        radius: f64,
+    },
+    /// The vertices whose initial 3D position lies in a ball.
+    Ball {
+        /// centre (m)
+        center: [f64; 3],
+        /// radius (m)
+        radius: f64,
+    },
+    /// The listed 0-based vertex indices (OBJ order).
     Vertices(Vec<usize>),
 }
 
@@ -464,9 +548,13 @@ impl Selection {
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct HandleSpec {
+    /// the name its reaction is reported under
     pub name: String,
+    /// the vertices it holds
     pub select: Selection,
+    /// its keyframes (time in s, offset in m)
     pub keyframes: Vec<Keyframe>,
+    /// linear (default) or Hermite interpolation between keyframes
     #[serde(default, skip_serializing_if = "is_linear")]
     pub interpolation: Interpolation,
 }

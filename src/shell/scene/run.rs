@@ -5,14 +5,23 @@ use super::*;
 /// Summary of a run.
 #[derive(Clone, Debug, Serialize)]
 pub struct RunSummary {
+    /// steps taken
     pub steps: usize,
+    /// triangles of the mesh
     pub triangles: usize,
+    /// vertices of the mesh
     pub vertices: usize,
+    /// Newton iterations over all steps
     pub newton_total: usize,
+    /// most Newton iterations of one step
     pub newton_max: usize,
+    /// steps reported as not converged (0: a step that cannot converge ends the run with an error)
     pub unconverged_steps: usize,
+    /// largest residual force at the end of a step (N)
     pub max_residual: f64,
+    /// wall time of the run (s)
     pub wall: f64,
+    /// the last step's report
     pub last: Option<StepReport>,
 }
 

@@ -86,8 +86,11 @@ use terms::Lagged;
 /// A named set of vertices following a keyframed translation from their initial positions.
 #[derive(Clone, Debug)]
 pub struct Handle {
+    /// the name its reaction is reported under
     pub name: String,
+    /// the vertices it moves
     pub vertices: Vec<usize>,
+    /// their translation from the initial positions over time (m)
     pub motion: Motion,
 }
 
@@ -103,7 +106,9 @@ impl Handle {
 pub struct Boundary {
     /// vertices held at their initial positions (their reaction is reported as `pinned`)
     pub pinned: Vec<usize>,
+    /// vertex sets following keyframed translations
     pub handles: Vec<Handle>,
+    /// the obstacles the cloth collides with
     pub obstacles: Vec<Obstacle>,
     /// the translation of each obstacle over time, in the order of `obstacles` (missing ones stay put)
     pub obstacle_motions: Vec<Motion>,
@@ -122,6 +127,7 @@ pub struct Settings {
     pub max_newton: usize,
     /// try the exact Hessian first and fall back to the PSD option's Hessian only when its factorisation fails
     pub exact_first: bool,
+    /// gravitational acceleration g (m/s²)
     pub gravity: [f64; 3],
     /// linear drag rate c (1/s)
     pub drag: f64,
@@ -178,7 +184,9 @@ impl Default for Settings {
 /// What one step did (the JSON-lines log entry).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct StepReport {
+    /// the number of the step (1 for the first)
     pub step: usize,
+    /// the simulated time at the end of the step (s)
     pub time: f64,
     /// Newton iterations over all substeps
     pub newton: usize,
@@ -197,10 +205,13 @@ pub struct StepReport {
     /// ends the run with [`ShellError::StepFailed`] instead of a report (kept in the log for the tools that read
     /// it)
     pub converged: bool,
+    /// elastic energy E(x) = Σ_triangles k A ψ(z) (barriers included) at the end of the step (J)
     pub energy_elastic: f64,
+    /// kinetic energy ½ Σ m_v |v_v|² at the end of the step (J)
     pub energy_kinetic: f64,
     /// potential energy of gravity relative to the initial state
     pub energy_gravity: f64,
+    /// obstacle penalty energy E_obst at the end of the step (J)
     pub energy_obstacles: f64,
     /// (name, force the held set exerts on the cloth, N) for every handle, then `pinned` (scenes hold their
     /// pins as fixed handles named `pin0`, `pin1`, …)
@@ -209,11 +220,14 @@ pub struct StepReport {
     pub shift: f64,
     /// wall time of the step (s)
     pub wall: f64,
+    /// componentwise minimum of the strain z = (s_x, s_a, s_y, II₀₀, II₀₁, II₁₁) over the triangles
     pub strain_min: [f64; 6],
+    /// componentwise maximum of z over the triangles
     pub strain_max: [f64; 6],
     /// componentwise 1st and 99th percentiles of z over the triangles (what most of the cloth visits, without
     /// the few triangles of a mesh-scale crease; `hylc scene-plan --quantile`)
     pub strain_p01: [f64; 6],
+    /// componentwise 99th percentile of z over the triangles
     pub strain_p99: [f64; 6],
 }
 
@@ -265,24 +279,36 @@ fn non_finite_material(
 
 /// A running simulation.
 pub struct Simulation {
+    /// the per-triangle model (reduced material, multipliers, PSD option)
     pub model: ElementModel,
+    /// the triangles with their rest shapes and hinge neighbours
     pub stencils: Vec<Stencil>,
+    /// the sparsity pattern of the free-dof Hessian and the stencils' scatter maps
     pub pattern: Pattern,
     symbolic: SymbolicCholesky<usize>,
     /// the Cholesky factor's values and faer's workspace, kept from one factorisation to the next
     factor_scratch: std::sync::Mutex<(Vec<f64>, faer::dyn_stack::MemBuffer)>,
+    /// initial positions, 3 per vertex (m)
     pub x0: Vec<f64>,
+    /// current positions, 3 per vertex (m)
     pub x: Vec<f64>,
+    /// current velocities, 3 per vertex (m/s)
     pub v: Vec<f64>,
     /// lumped vertex masses (kg)
     pub mass: Vec<f64>,
+    /// vertices held at their initial positions
     pub pinned: Vec<usize>,
+    /// vertex sets following keyframed translations
     pub handles: Vec<Handle>,
+    /// the obstacles
     pub obstacles: Vec<Obstacle>,
     /// one per obstacle
     pub obstacle_motions: Vec<Motion>,
+    /// the solver settings
     pub settings: Settings,
+    /// the simulated time (s)
     pub time: f64,
+    /// steps taken so far
     pub steps: usize,
     /// current substep level: h = dt / 2^level
     level: u32,

@@ -42,10 +42,20 @@ pub const ORIGINAL_GRIDS: [(&str, &str); 5] = [
 pub enum GridError {
     /// A file could not be read.
     #[error("{}: {message}", path.display())]
-    Io { path: PathBuf, message: String },
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
     /// A file was read but its content is not what the format requires.
     #[error("{}: {message}", path.display())]
-    Format { path: PathBuf, message: String },
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// The data does not fit the pattern (vertex count).
     #[error("{0}")]
     Mismatch(String),
@@ -177,6 +187,7 @@ pub fn read_axes(path: &Path) -> Result<[[f64; AXIS_LEN]; 3], GridError> {
 pub struct GridData {
     /// The nine values of s_x, s_a, s_y.
     pub axes: [[f64; AXIS_LEN]; 3],
+    /// Vertices n of the pattern the data belongs to.
     pub n_vertices: usize,
     /// Row-major (n·729, 4).
     values: Vec<f32>,
@@ -319,24 +330,31 @@ pub enum Start {
     /// From the reference state.
     Cold,
     /// From the converged state of this grid point.
-    Warm { from: usize },
+    Warm {
+        /// The grid index of the converged point it started from.
+        from: usize,
+    },
 }
 
 /// One solve at one grid point.
 #[derive(Clone, Debug, Serialize)]
 pub struct Attempt {
+    /// How the attempt started.
     pub start: Start,
     /// The solver's status, or `None` when it stopped with an error.
     pub status: Option<Status>,
     /// The error message when the solve stopped with an error.
     pub error: Option<String>,
+    /// Newton steps taken.
     pub steps: usize,
+    /// Final ‖g‖_∞ of the projected reduced gradient (N).
     pub gradient_norm: f64,
     /// Wall time (s).
     pub time: f64,
 }
 
 impl Attempt {
+    /// Whether the solve converged.
     pub fn converged(&self) -> bool {
         self.status == Some(Status::Converged)
     }
@@ -345,7 +363,9 @@ impl Attempt {
 /// The result at one grid point.
 #[derive(Clone, Debug)]
 pub struct PointResult {
+    /// Grid index isx + 9·isa + 81·isy.
     pub index: usize,
+    /// The macro strain of the point.
     pub strain: MacroStrain,
     /// The continuation attempts in order (warm, then cold when the warm one failed).
     pub attempts: Vec<Attempt>,
@@ -556,11 +576,15 @@ pub fn run_grid(
 /// RMS and maximum of an error over (grid point, vertex) pairs, with where the maximum occurs.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct ErrorStats {
+    /// Root mean square of the error.
     pub rms: f64,
+    /// Largest error.
     pub max: f64,
     /// (s_x, s_a, s_y) of the maximum.
     pub max_strain: [f64; 3],
+    /// The vertex of the maximum.
     pub max_vertex: usize,
+    /// Number of (grid point, vertex) pairs.
     pub count: usize,
 }
 
@@ -601,13 +625,19 @@ impl Accum {
 /// Newton steps and wall time of a set of solves.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct StepStats {
+    /// Number of solves.
     pub solves: usize,
+    /// Solves that converged.
     pub converged: usize,
+    /// Median Newton steps per solve.
     pub median_steps: f64,
+    /// Most Newton steps of a solve.
     pub max_steps: usize,
+    /// Mean Newton steps per solve.
     pub mean_steps: f64,
     /// Mean wall time per solve (s).
     pub mean_time: f64,
+    /// Median wall time per solve (s).
     pub median_time: f64,
 }
 
@@ -671,7 +701,9 @@ pub struct Failure {
     pub start: String,
     /// The status, or "error: …".
     pub status: String,
+    /// Newton steps taken.
     pub steps: usize,
+    /// Final ‖g‖_∞ of the projected reduced gradient (N).
     pub gradient_norm: f64,
     /// Whether the point converged in the end (a cold retry after a failed warm solve).
     pub recovered: bool,
@@ -680,10 +712,15 @@ pub struct Failure {
 /// Per-pattern summary of a grid run (the content of `validation/micro_grid.json`).
 #[derive(Clone, Debug, Serialize)]
 pub struct GridSummary {
+    /// Vertices of the pattern.
     pub vertices: usize,
+    /// Yarn radius r (m).
     pub radius: f64,
+    /// The pattern's periods (m).
     pub periods: [f64; 2],
+    /// Whether each yarn's slide along itself was constrained.
     pub slide_constraints: bool,
+    /// The solver's dimensionless force tolerance.
     pub tolerance: f64,
     /// Grid points solved by the continuation (729 for a full run).
     pub points: usize,

@@ -26,6 +26,7 @@ use serde::Serialize;
 /// One convention's errors at the six nearest grid points.
 #[derive(Clone, Debug, Serialize)]
 pub struct ConventionRow {
+    /// The convention's name.
     pub name: &'static str,
     /// RMS position error over the six points and the vertices (r).
     pub position_rms: f64,

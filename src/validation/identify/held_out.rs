@@ -16,9 +16,13 @@ use serde::Serialize;
 /// One 1D curve: strains, the original's ψ, our Ψ̄, and the relative RMS error.
 #[derive(Clone, Debug, Serialize)]
 pub struct CurveComparison {
+    /// The strain component along which the curve runs.
     pub component: &'static str,
+    /// The strains of the points.
     pub strains: Vec<f64>,
+    /// The original material's ψ at the points (J/m²).
     pub original: Vec<f64>,
+    /// Our Ψ̄ at the points (J/m²; NaN where the solve failed).
     pub ours: Vec<f64>,
     /// ‖Ψ̄ − ψ‖ / ‖ψ‖ over the points (RMS ratio).
     pub rel_rms: f64,
@@ -88,14 +92,19 @@ pub fn compare_curve(
 /// The item-5 numbers of one parameter set.
 #[derive(Clone, Debug, Serialize)]
 pub struct HeldOut {
+    /// The yarn parameters.
     pub yarn: YarnMaterial,
     /// Full-grid position error RMS and max (r), None when the grid was not run.
     pub grid_rms: Option<f64>,
+    /// Full-grid position error maximum (r).
     pub grid_max: Option<f64>,
+    /// Grid points that converged.
     pub grid_converged: Option<usize>,
     /// RMS position error per axis value (rows s_x, s_a, s_y).
     pub grid_rms_by_axis: Option<[[f64; AXIS_LEN]; 3]>,
+    /// The grid's axis values (rows s_x, s_a, s_y).
     pub axes: Option<[[f64; AXIS_LEN]; 3]>,
+    /// The 1D curves against the original material.
     pub curves: Vec<CurveComparison>,
 }
 
@@ -138,8 +147,11 @@ pub fn held_out(
 /// θ = Y, G, γ, k_c, f (envelope theorem at the equilibrium).
 #[derive(Clone, Debug, Serialize)]
 pub struct StudyCurve {
+    /// The strain component along which the curve runs.
     pub component: &'static str,
+    /// The strains of the points.
     pub strains: Vec<f64>,
+    /// Ψ̄ at the points (J/m²).
     pub psi: Vec<f64>,
     /// Per parameter (Y, G, γ, k_c, f), one value per strain.
     pub dpsi_dlog: [Vec<f64>; 5],

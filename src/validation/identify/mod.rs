@@ -50,17 +50,23 @@ pub const BOUNDS: [[f64; 2]; 5] = [
 /// Identification failed.
 #[derive(Debug, thiserror::Error)]
 pub enum IdentifyError {
+    /// The original's micro grid could not be read.
     #[error(transparent)]
     Grid(#[from] GridError),
+    /// A micro problem could not be set up or solved.
     #[error(transparent)]
     Micro(#[from] MicroError),
+    /// The contact quadrature could not be set up.
     #[error("contact: {0}")]
     Contact(#[from] ContactError),
     /// A solve the residuals need did not converge.
     #[error("{what} at {strain}: the micro solve did not converge ({status})")]
     NotConverged {
+        /// Which residual's solve (e.g. a grid point or curve strain).
         what: String,
+        /// The macro strain of the solve.
         strain: MacroStrain,
+        /// How the solve ended.
         status: Status,
     },
     /// Bad input: the argument or file at fault and why.
@@ -69,7 +75,9 @@ pub enum IdentifyError {
     /// A plot could not be drawn or written.
     #[error("{}: cannot draw the plot: {message}", path.display())]
     Plot {
+        /// The plot file.
         path: std::path::PathBuf,
+        /// The plotting library's message.
         message: String,
     },
 }
@@ -113,7 +121,9 @@ pub fn clamp(q: &mut [f64; 5]) -> Vec<&'static str> {
 /// Residual (a): the pattern whose stored state is compared (its periods may differ from the solves' pattern:
 /// [`stored_state_pattern`]) and the weight.
 pub struct StoredTarget {
+    /// The pattern whose stored state (a) is compared.
     pub pattern: Pattern,
+    /// Weight of residual (a).
     pub weight: f64,
 }
 
@@ -155,13 +165,17 @@ pub struct Residuals {
 pub struct IdentifyOptions {
     /// Which unknowns move (the others stay at the start value).
     pub free: [bool; 5],
+    /// Levenberg–Marquardt iterations at most.
     pub max_iterations: usize,
+    /// Stop when the relative decrease of the cost ½‖r‖² is below this.
     pub cost_tolerance: f64,
+    /// Stop when the largest step of an unknown (in ln θ) is below this.
     pub step_tolerance: f64,
     /// Initial λ.
     pub lambda: f64,
     /// Largest change of any unknown in one step (a trust region in ln θ; a longer step is scaled down).
     pub max_step: f64,
+    /// Options of the micro solves.
     pub solver: SolverOptions,
 }
 
@@ -196,8 +210,11 @@ pub struct Breakdown {
 
 /// Residual vector, Jacobian (m × 5) and breakdown at one parameter set.
 pub struct Evaluation {
+    /// The weighted residual vector r (m entries).
     pub residual: Vec<f64>,
+    /// The Jacobian ∂r/∂q, one row of 5 per residual.
     pub jacobian: Vec<[f64; 5]>,
+    /// The residuals' sizes.
     pub breakdown: Breakdown,
 }
 
@@ -245,8 +262,11 @@ pub fn evaluate(
 /// One Levenberg–Marquardt iteration as reported.
 #[derive(Clone, Debug, Serialize)]
 pub struct Iteration {
+    /// Iteration number (0: the start).
     pub iteration: usize,
+    /// The unknowns q = (ln Y, ln γ, ln G/Y, ln k_c, ln f) after the iteration.
     pub unknowns: [f64; 5],
+    /// The residuals' sizes after the iteration.
     pub breakdown: Breakdown,
     /// λ of the accepted step.
     pub lambda: f64,
@@ -263,20 +283,29 @@ pub struct Iteration {
 /// The outcome of [`identify`].
 #[derive(Clone, Debug, Serialize)]
 pub struct Identification {
+    /// The start parameters.
     pub start: YarnMaterial,
+    /// The identified parameters.
     pub identified: YarnMaterial,
+    /// The identified unknowns q = (ln Y, ln γ, ln G/Y, ln k_c, ln f).
     pub unknowns: [f64; 5],
+    /// Which unknowns moved.
     pub free: [bool; 5],
     /// Standard errors of the free unknowns (of ln θ: relative errors of the parameters); `None` when fixed.
     pub standard_errors: [Option<f64>; 5],
     /// Correlations of the unknowns (fixed ones: zero rows).
     pub correlations: [[f64; 5]; 5],
+    /// The residuals' sizes at the start.
     pub before: Breakdown,
+    /// The residuals' sizes at the identified parameters.
     pub after: Breakdown,
+    /// The accepted iterations, the start first.
     pub iterations: Vec<Iteration>,
     /// Why the iteration stopped.
     pub stopped: String,
+    /// Number m of residuals.
     pub residual_count: usize,
+    /// Wall time (s).
     pub time: f64,
 }
 

@@ -10,8 +10,11 @@ use std::path::Path;
 
 /// One series of a line plot: label, points, colour (index into a fixed palette), dashed markers only.
 pub struct Series {
+    /// Legend label.
     pub label: String,
+    /// The points (x, y).
     pub points: Vec<(f64, f64)>,
+    /// Colour: an index into the palette.
     pub colour: usize,
     /// Draw markers only (no line).
     pub markers: bool,

@@ -158,19 +158,24 @@ pub fn stored_state(
 
 /// The original's displacement data at a set of grid points (residual b).
 pub struct GridTarget {
+    /// The original's displacements.
     pub data: GridData,
     /// Compared grid points (indices), the start point excluded.
     pub points: Vec<usize>,
+    /// Weight of residual (b).
     pub weight: f64,
 }
 
 /// Points along one or more strain axes with the original material's ψ there (residual c).
 pub struct CurveTarget {
+    /// The strains of the points.
     pub strains: Vec<MacroStrain>,
+    /// The original material's ψ at the points (J/m²).
     pub values: Vec<f64>,
     /// Per point: the RMS of the original's values along its axis (each curve's errors are relative to its own
     /// size, so a bending curve of 0.1 J/m² counts as much as a stretching curve of 30 J/m²).
     pub scales: Vec<f64>,
+    /// Weight of residual (c).
     pub weight: f64,
 }
 
@@ -207,8 +212,11 @@ impl CurveTarget {
 /// (c) the curve points.
 #[derive(Clone, Default)]
 pub struct WarmStates {
+    /// (b) the state at the grid's start point.
     pub grid_zero: Option<MicroState>,
+    /// (b) the state at each compared point.
     pub grid: Vec<Option<MicroState>>,
+    /// (c) the state at each curve point.
     pub curve: Vec<Option<MicroState>>,
 }
 
@@ -327,7 +335,9 @@ pub fn grid_residual(
 
 /// Residual (b) at one parameter set ([`grid_residual`]).
 pub struct GridResidual {
+    /// The weighted residuals.
     pub residual: Vec<f64>,
+    /// Their Jacobian ∂r/∂q, one row per residual.
     pub jacobian: Vec<[f64; 5]>,
     /// RMS position error over the compared points and vertices (r).
     pub rms: f64,

@@ -57,17 +57,31 @@ pub use trajectory::{Tape, TapeStep};
 #[derive(Clone, Debug, PartialEq)]
 pub enum Observable {
     /// component `axis` (0, 1, 2) of the mass-weighted centre of all vertices
-    CenterOfMass { axis: usize },
+    CenterOfMass {
+        /// the component (0, 1, 2)
+        axis: usize,
+    },
     /// the elastic energy E (the triangles' energies with their barriers)
     ElasticEnergy,
     /// component `axis` of the force the held set `set` exerts on the cloth (a handle's name or `pinned`;
     /// `handle_forces` of the step report)
-    Reaction { set: String, axis: usize },
+    Reaction {
+        /// the held set (a handle's name or `pinned`)
+        set: String,
+        /// the component (0, 1, 2)
+        axis: usize,
+    },
     /// ½ Σ_v |x_v − x̂_v|² over every vertex
-    Target { positions: Vec<[f64; 3]> },
+    Target {
+        /// the target positions x̂_v, one per vertex (m)
+        positions: Vec<[f64; 3]>,
+    },
     /// Σ_v w_v · x_v: with w a cotangent on the positions, the gradient is the vector–Jacobian product
     /// wᵀ dx*/dp
-    Linear { weights: Vec<[f64; 3]> },
+    Linear {
+        /// the weights w_v, one per vertex
+        weights: Vec<[f64; 3]>,
+    },
 }
 
 /// dJ/dp of one observable at an equilibrium.

@@ -36,9 +36,13 @@ use crate::shell::ShellError;
 /// The states a dynamic run passed through: its start and every accepted substep.
 #[derive(Clone, Debug, Default)]
 pub struct Tape {
+    /// positions at the start, 3 per vertex (m)
     pub x0: Vec<f64>,
+    /// velocities at the start, 3 per vertex (m/s)
     pub v0: Vec<f64>,
+    /// time at the start (s)
     pub t0: f64,
+    /// the accepted substeps in order
     pub steps: Vec<TapeStep>,
 }
 
