@@ -8,7 +8,6 @@ use crate::pattern::pattern_of;
 use crate::progress::{callback, interruptible};
 use crate::yarn::yarn_of;
 use hylc::micro::{CrossingGuard, MicroProblem, Predictor, SolverOptions, StepRule};
-use hylc::sample::starts::DEFAULT_DISAGREEMENT;
 use hylc::sample::{parse_shard, run_plan_until, Plan, RunOptions, Starts};
 use hylc::workflow::inputs::load_plan;
 use hylc::workflow::sidecar::write_meta;
@@ -227,9 +226,9 @@ fn solver_options(
 ///     The predictor of warm starts along a chain.
 /// starts : {"warm", "warm+cold", "all"}, default "warm"
 ///     The starts of every sample (docs/sampling.md, "Multi-start").
-/// disagreement : float, default 1e-6
+/// disagreement : float, optional
 ///     ``starts="all"``: the relative difference of the warm and cold Ψ̄ above which the reversed chain is
-///     tried.
+///     tried (default 1e-6, the library's).
 /// sensitivities : bool, default False
 ///     Store ∂Ψ̄/∂θ and dσ/dθ of the six yarn parameters in every converged record (and add them to the
 ///     finished records that lack them).
@@ -258,11 +257,12 @@ fn solver_options(
 /// FileNotFoundError
 ///     A pattern or plan file that does not exist.
 /// SampleError
-///     A plan that is not valid, or a sample file of another problem (pattern, yarn or solver settings).
+///     A plan that is not valid, ``starts`` other than warm with ``cold``, or a sample file of another
+///     problem (pattern, yarn or solver settings).
 /// KeyboardInterrupt
 ///     Ctrl-C (noticed within 0.05 s; the records written so far stay, a later call resumes).
 #[pyfunction]
-#[pyo3(signature = (pattern, out, plan=None, *, yarn=None, cold=false, shard=None, limit=None, predictor="secant", starts="warm", disagreement=DEFAULT_DISAGREEMENT, sensitivities=false, tolerance=1e-8, max_steps=2000, time_limit=None, crossings=None, inertia=true, progress=None))]
+#[pyo3(signature = (pattern, out, plan=None, *, yarn=None, cold=false, shard=None, limit=None, predictor="secant", starts="warm", disagreement=None, sensitivities=false, tolerance=1e-8, max_steps=2000, time_limit=None, crossings=None, inertia=true, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn sample<'py>(
     py: Python<'py>,
@@ -275,7 +275,7 @@ pub fn sample<'py>(
     limit: Option<usize>,
     predictor: &str,
     starts: &str,
-    disagreement: f64,
+    disagreement: Option<f64>,
     sensitivities: bool,
     tolerance: f64,
     max_steps: usize,
@@ -313,7 +313,7 @@ pub fn sample<'py>(
         limit,
         predictor,
         starts,
-        disagreement: Some(disagreement),
+        disagreement,
         sensitivities,
     };
     let s = interruptible(py, progress.as_ref(), |m| {
