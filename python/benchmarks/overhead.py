@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The Python module's overheads (issue 21, targets): import time, a batch ψ of 10⁵ strains against the plain Rust
+"""The Python module's overheads (docs/python.md): import time, a batch ψ of 10⁵ strains against the plain Rust
 loop over the same strains, and a micro solve against the CLI's solve time, all measured in one run.
 
     python python/benchmarks/overhead.py [--hylc target/release/hylc] [--repeat 5]

@@ -1,4 +1,4 @@
-"""Homogenized yarn-level cloth from Python (issue 21).
+"""Homogenized yarn-level cloth from Python (the guide's chapter: docs/python.md).
 
 The compiled module ``hylc._hylc`` does the work; this package re-exports it:
 
@@ -8,15 +8,21 @@ The compiled module ``hylc._hylc`` does the work; this package re-exports it:
   ``stress()``, ``positions``, ``parameter_derivatives()``, ``strain_stiffness()``,
   ``equilibrium_sensitivities()``); yarn parameters as dicts: :func:`yarn_defaults`, :func:`load_yarn`,
   :func:`save_yarn`;
+- sampling (Algorithm C4): :func:`plan` (the built-in plans as dicts), :func:`plan_samples` (a plan's strains and
+  ids), :func:`sample` (a plan on a pattern to a resumable sample file, with ``progress`` and Ctrl-C);
 - materials: :class:`Material` (``load``, ``default``, ``save``, ``psi``, ``gradient``, ``hessian``, ``eval`` over
   (N, 6) arrays) and :func:`fit` (Algorithm C5 on a sample file);
-- cloth: :func:`simulate` (a scene file or built-in; the step log as arrays and the final positions) and
-  :func:`gradient` (dJ/dp of an observable of a quasi-static scene, or a vector–Jacobian product, by one adjoint
-  solve).
+- cloth: :func:`load_scene` (a scene file or built-in as a dict), :func:`simulate` (a scene file, built-in or
+  dict; the step log as arrays and the final positions) and :func:`gradient` (dJ/dp of an observable, or a
+  vector–Jacobian product, by an adjoint solve);
+- the derivative harness: :func:`check_derivatives` (every registered function's derivatives against AD and
+  finite differences, one dict per function).
 
 Errors: bad arguments raise ``ValueError``, missing files ``FileNotFoundError``, failures of the library a
 subclass of :class:`Error`, with the message the command line prints after ``error:``. The GIL is released while
-the library works, so Python threads can run solves in parallel.
+the library works, so Python threads can run solves in parallel. The long calls (:func:`sample`,
+:func:`simulate`, :func:`check_derivatives`) take ``progress=callable(done, total)`` and stop on Ctrl-C
+(``KeyboardInterrupt``) after the unit of work in flight.
 """
 
 from ._hylc import (
@@ -33,13 +39,18 @@ from ._hylc import (
     SimulationError,
     Solution,
     __version__,
+    check_derivatives,
     fit,
     generate,
     gradient,
     load_pattern,
+    load_scene,
     load_yarn,
+    plan,
+    plan_samples,
     read_pyp,
     reference_state,
+    sample,
     save_yarn,
     simulate,
     yarn_defaults,
@@ -69,13 +80,18 @@ __all__ = [
     "MATERIAL_STRAIN",
     "PARAMETERS",
     "__version__",
+    "check_derivatives",
     "fit",
     "generate",
     "gradient",
     "load_pattern",
+    "load_scene",
     "load_yarn",
+    "plan",
+    "plan_samples",
     "read_pyp",
     "reference_state",
+    "sample",
     "save_yarn",
     "simulate",
     "yarn_defaults",

@@ -1,11 +1,13 @@
-//! Cloth scenes (Algorithm C8, `hylc simulate`): run a scene file or built-in and return its step log as arrays
-//! and its final state.
+//! Cloth scenes (Algorithm C8, `hylc simulate`): run a scene file, built-in or dict and return its step log as
+//! arrays and its final state.
 
 use crate::arrays::to_2d;
-use crate::errors::{detached, HyError};
-use hylc::shell::scene::run_with;
+use crate::errors::HyError;
+use crate::progress::{callback, interruptible};
+use crate::scene::SceneArg;
+use hylc::shell::scene::run_until;
 use hylc::shell::solver::StepReport;
-use hylc::workflow::simulate::{prepare, Overrides, TimeTol};
+use hylc::workflow::simulate::{Overrides, TimeTol};
 use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -66,25 +68,67 @@ impl TolArg {
     }
 }
 
-/// Run a cloth scene (a scene JSON file, an ARCSim scene file or a built-in: stretch-x, stretch-y, drape-x,
-/// drape-y, hanging) as `hylc simulate` does, with its overrides. With `out`, the frames (`frame_NNNN.obj`) and
-/// `log.jsonl` are written there as well. Returns a dict: the step log as (steps,) arrays (`step`, `time`,
-/// `newton`, `residual`, energies, …; `strain_*` (steps, 6); `handle_forces` name → (steps, 3)), `positions`
-/// (vertices, 3) and `triangles` (triangles, 3) of the final state, and `summary` (steps, Newton iterations,
-/// wall time). `time_tol` (m) chooses substeps by their estimated error, as the scene's `solver.time_tol`, and
-/// `"off"` turns that off. A step that fails even at the smallest substep raises `SimulationError`.
+/// Run a cloth scene as ``hylc simulate`` does, with its overrides.
+///
+/// Parameters
+/// ----------
+/// scene : str, path-like or dict
+///     A scene JSON file, an ARCSim scene file, a built-in (``stretch-x``, ``stretch-y``, ``drape-x``,
+///     ``drape-y``, ``hanging``) or a dict with the scene JSON's layout (:func:`load_scene` gives one; its
+///     relative paths start from the working directory).
+/// out : path-like, optional
+///     A folder for the frames (``frame_NNNN.obj``), ``log.jsonl``, ``handle_forces.csv`` and
+///     ``provenance.json``; nothing is written without it.
+/// material : str, optional
+///     A material file (relative to the working directory) or ``"default"`` instead of the scene's.
+/// duration, dt : float, optional
+///     The simulated time and the step (s) instead of the scene's.
+/// edge : float, optional
+///     The edge length (m) of a rectangle mesh.
+/// time_tol : float or "off", optional
+///     The largest estimated local error (m) of a substep (the scene's ``solver.time_tol``); ``"off"`` makes
+///     substeps shorten only when Newton fails.
+/// vtu : bool, default False
+///     Also a ``frame_NNNN.vtu`` beside each OBJ frame and the series ``frames.pvd`` (``--format vtu``).
+/// progress : callable, optional
+///     ``progress(done, total)`` with the time steps done of the scene's, called from the calling thread
+///     (GIL held) with the latest counts at most every 0.05 s and after the last step. An exception it raises
+///     stops the run after the step in flight and is raised.
+///
+/// Returns
+/// -------
+/// SimulationResult
+///     The step log as (steps,) arrays (``step``, ``time``, ``newton``, ``substeps``, ``dt_min``,
+///     ``rejected``, ``error_estimate``, ``residual``, ``energy_*``, ``shift``, ``wall``), ``strain_min``,
+///     ``strain_max``, ``strain_p01``, ``strain_p99`` (steps, 6), ``handle_forces`` (name → (steps, 3) N),
+///     ``positions`` (vertices, 3) and ``triangles`` (triangles, 3, int64) of the final state, and ``summary``
+///     (steps, triangles, vertices, Newton iterations, largest residual, wall time).
+///
+/// Raises
+/// ------
+/// FileNotFoundError
+///     A scene file that does not exist.
+/// ValueError
+///     A bad override (``dt``, ``time_tol``, ``edge`` of a mesh file).
+/// SimulationError
+///     A scene that is not valid, or a step that fails even at the smallest substep.
+/// KeyboardInterrupt
+///     Ctrl-C during the run (noticed within 0.05 s; the run stops after the step in flight, the files written
+///     so far stay complete).
 #[pyfunction]
-#[pyo3(signature = (scene, out=None, material=None, duration=None, dt=None, edge=None, time_tol=None))]
+#[pyo3(signature = (scene, out=None, material=None, duration=None, dt=None, edge=None, time_tol=None, vtu=false, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
     py: Python<'py>,
-    scene: &str,
+    scene: &Bound<'py, PyAny>,
     out: Option<PathBuf>,
     material: Option<String>,
     duration: Option<f64>,
     dt: Option<f64>,
     edge: Option<f64>,
     time_tol: Option<TolArg>,
+    vtu: bool,
+    progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let time_tol = time_tol.map(TolArg::parse).transpose()?;
     let ov = Overrides {
@@ -93,28 +137,22 @@ pub fn simulate<'py>(
         dt,
         edge,
         time_tol,
+        vtu,
         ..Default::default()
     };
-    let path = std::path::Path::new(scene);
-    if path.extension().is_some() && !path.exists() {
-        return Err(HyError::new(
-            crate::errors::Kind::NotFound,
-            format!("scene: {scene}: no such scene file"),
-        )
-        .into());
-    }
-    let (log, summary, positions, triangles) = detached(py, || {
-        let (sc, dir) = prepare(scene, &ov)?;
-        let (mut sim, tris) = sc.build(scene, &dir).map_err(HyError::from)?;
+    let arg = SceneArg::of(scene)?;
+    let progress = callback(progress)?;
+    let (log, summary, positions, triangles) = interruptible(py, progress.as_ref(), |m| {
+        let (sc, dir) = arg.prepare(&ov)?;
+        let (mut sim, tris) = sc.build(arg.label(), &dir).map_err(HyError::from)?;
+        let steps = sc.steps();
+        m.report(0, steps);
         let mut log = Vec::new();
-        let summary = run_with(
-            &mut sim,
-            &tris,
-            sc.steps(),
-            &sc.output,
-            out.as_deref(),
-            |r| log.push(r.clone()),
-        )?;
+        let summary = run_until(&mut sim, &tris, steps, &sc.output, out.as_deref(), |r| {
+            log.push(r.clone());
+            m.report(log.len(), steps);
+            !m.cancelled()
+        })?;
         Ok((log, summary, sim.positions(), tris))
     })?;
     let d = PyDict::new(py);

@@ -141,6 +141,7 @@ library_errors! {
     hylc::rod::YarnFileError => Value,
     hylc::shell::ShellError => Simulation,
     hylc::sample::SampleError => Sample,
+    hylc::sample::PlanError => Sample,
 }
 
 impl From<hylc::pattern::PatternError> for HyError {
@@ -211,15 +212,20 @@ pub fn detached<T: Send>(py: Python<'_>, f: impl FnOnce() -> HyResult<T> + Send)
     let out = py.detach(|| catch_unwind(AssertUnwindSafe(f)));
     match out {
         Ok(r) => r.map_err(PyErr::from),
-        Err(payload) => {
-            let what = payload
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "unknown panic".into());
-            Err(InternalError::new_err(format!("internal error: {what}")))
-        }
+        Err(payload) => Err(InternalError::new_err(format!(
+            "internal error: {}",
+            panic_message(&*payload)
+        ))),
     }
+}
+
+/// The message of a caught panic's payload.
+pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into())
 }
 
 /// Add the exception classes to the module.

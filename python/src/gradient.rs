@@ -4,30 +4,65 @@
 use crate::arrays::rows;
 use crate::convert::json_to_numpy;
 use crate::errors::{detached, HyError};
+use crate::scene::SceneArg;
 use crate::yarn::yarn_of;
 use hylc::workflow::gradient::{gradient as run_gradient, GradientOptions, YarnChainInput};
-use hylc::workflow::simulate::{prepare, Overrides};
+use hylc::workflow::simulate::Overrides;
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
-/// dJ/dp of a scene (a scene JSON file, an ARCSim scene or a built-in) at its last step, as `hylc gradient`
-/// computes it (a quasi-static equilibrium by one adjoint solve, a dynamic run by the discrete adjoint of its
-/// implicit Euler substeps): `observable` is `com-x|y|z`, `energy`, `handle-force:NAME:x|y|z` or
-/// `target:FILE.obj`; or, instead, `cotangent` (vertices, 3) gives J = Σ w_v · x_v, so that the result is the
-/// vector–Jacobian product wᵀ dx*/dp. `at` (s) picks the step nearest it (default the last); `check` adds
-/// central differences of re-solves. Returns the content of `gradient.json` as dicts of numpy arrays:
-/// `value`, `time`, `residual`, `scene` (`stiffness`, `bending_scale`, `mass`, `gravity`), `held` (per held set
-/// `translation` (3,) and `keyframes` (k, 3)), `obstacles` (n, 3), `material` (the material file's layout with
-/// dJ/dc in place of each coefficient) and `check`. With `samples` (the sample file the material was fitted to,
-/// made with `sensitivities`) and `yarn` (its yarn parameters: a dict, a file or None for the defaults) also
-/// `yarn` (name → dJ/dθ) and `yarn_chain` (the fit's kinks, samples used). The frames and the log go to `out`
-/// (a temporary folder by default).
+/// Sensitivities dJ/dp of a scene's observable at one step, as ``hylc gradient`` computes them.
+///
+/// A quasi-static equilibrium is differentiated by one adjoint solve, a dynamic run by the discrete adjoint of
+/// its implicit Euler substeps (docs/sensitivities.md).
+///
+/// Parameters
+/// ----------
+/// scene : str, path-like or dict
+///     A scene JSON file, an ARCSim scene, a built-in or a dict with the scene JSON's layout.
+/// observable : str, optional
+///     ``com-x``, ``com-y``, ``com-z``, ``energy``, ``handle-force:NAME:x|y|z`` or ``target:FILE.obj``.
+/// cotangent : array_like, optional
+///     Instead of ``observable``: weights w (vertices, 3), J = Σ w_v · x_v, so that the result is the
+///     vector–Jacobian product wᵀ dx*/dp.
+/// at : float, optional
+///     The time (s) of the step to differentiate (the nearest step; default the last).
+/// material : str, optional
+///     A material file or ``"default"`` instead of the scene's.
+/// out : path-like, optional
+///     A folder for the frames, the log and ``gradient.json`` (a temporary folder, removed, by default).
+/// check : bool, default False
+///     Also central differences of re-solves for a few coefficients (``check`` in the result).
+/// samples : path-like, optional
+///     The sample file the material was fitted to (made with ``sensitivities=True``): adds dJ/dθ of the yarn
+///     parameters through the fit (``yarn``, ``yarn_chain``).
+/// yarn : dict, path-like or None
+///     The yarn parameters of ``samples`` (a dict, a yarn JSON file, or None for the defaults).
+///
+/// Returns
+/// -------
+/// GradientResult
+///     The content of ``gradient.json`` with numeric lists as numpy arrays: ``value``, ``time``, ``residual``,
+///     ``scene`` (``stiffness``, ``bending_scale``, ``mass``, ``gravity``), ``held`` (per held set
+///     ``translation`` (3,) and ``keyframes`` (k, 3)), ``obstacles``, ``material`` (the material file's layout
+///     with dJ/dc in place of each coefficient), ``check``, and with ``samples`` ``yarn`` (name → dJ/dθ) and
+///     ``yarn_chain``.
+///
+/// Raises
+/// ------
+/// ValueError
+///     Not exactly one of ``observable`` and ``cotangent``; a cotangent of the wrong shape; ``yarn`` without
+///     ``samples``; a scene the adjoint does not cover (e.g. damping).
+/// FileNotFoundError
+///     A scene or sample file that does not exist.
+/// SimulationError
+///     A scene that is not valid or whose step did not converge.
 #[pyfunction]
 #[pyo3(signature = (scene, observable=None, cotangent=None, at=None, material=None, out=None, check=false, samples=None, yarn=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn gradient<'py>(
     py: Python<'py>,
-    scene: &str,
+    scene: &Bound<'py, PyAny>,
     observable: Option<String>,
     cotangent: Option<Bound<'py, PyAny>>,
     at: Option<f64>,
@@ -87,8 +122,9 @@ pub fn gradient<'py>(
         material,
         ..Default::default()
     };
+    let arg = SceneArg::of(scene)?;
     let json = detached(py, || {
-        let (sc, dir) = prepare(scene, &ov)?;
+        let (sc, dir) = arg.prepare(&ov)?;
         let tmp;
         let folder = match &out {
             Some(o) => o.clone(),
@@ -97,7 +133,7 @@ pub fn gradient<'py>(
                 tmp.clone()
             }
         };
-        let o = run_gradient(&sc, scene, &dir, &folder, &opts, &mut |_| {})?;
+        let o = run_gradient(&sc, arg.label(), &dir, &folder, &opts, &mut |_| {})?;
         if out.is_none() {
             let _ = std::fs::remove_dir_all(&folder);
         }

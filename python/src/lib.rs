@@ -1,9 +1,12 @@
-//! The `hylc` Python module (issue 21): patterns, micro solves and their sensitivities, materials and fitting,
-//! cloth scenes, with numpy arrays in and out. The Python package `hylc` (`python/hylc/__init__.py`) re-exports
+//! The `hylc` Python module (the guide's Python chapter, docs/python.md): patterns, micro solves and their
+//! sensitivities, sampling plans and sample files, materials and fitting, cloth scenes, the derivative harness,
+//! with numpy arrays in and out. The Python package `hylc` (`python/hylc/__init__.py`) re-exports
 //! everything here. Every entry point releases the GIL while the library works, turns a panic into
-//! `hylc.InternalError` and a library error into the exception class of `errors`, with the command line's message.
+//! `hylc.InternalError` and a library error into the exception class of `errors`, with the command line's message;
+//! the long calls (`progress`) poll Ctrl-C and report progress from the calling thread.
 
 mod arrays;
+mod checks;
 mod cloth;
 mod convert;
 mod errors;
@@ -11,6 +14,9 @@ mod gradient;
 mod material;
 mod micro;
 mod pattern;
+mod progress;
+mod sample;
+mod scene;
 mod yarn;
 
 use pyo3::prelude::*;
@@ -38,6 +44,11 @@ fn _hylc(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(yarn::load_yarn, m)?)?;
     m.add_function(wrap_pyfunction!(yarn::save_yarn, m)?)?;
     m.add_function(wrap_pyfunction!(material::fit, m)?)?;
+    m.add_function(wrap_pyfunction!(sample::plan, m)?)?;
+    m.add_function(wrap_pyfunction!(sample::plan_samples, m)?)?;
+    m.add_function(wrap_pyfunction!(sample::sample, m)?)?;
+    m.add_function(wrap_pyfunction!(checks::check_derivatives, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::load_scene, m)?)?;
     m.add_function(wrap_pyfunction!(cloth::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(gradient::gradient, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_at_the_boundary, m)?)?;

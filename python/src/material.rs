@@ -14,6 +14,9 @@ use std::time::Instant;
 
 /// A fitted energy density ψ(z) of the cloth (J/m²) as a function of the strain z = (s_x, s_a, s_y, II00, II01,
 /// II11).
+///
+/// Made by :meth:`Material.load`, :meth:`Material.default` or :func:`fit`; ``psi``, ``gradient``, ``hessian``
+/// and ``eval`` take one strain (6,) or a batch (N, 6).
 #[pyclass(module = "hylc", name = "Material", frozen)]
 pub struct PyMaterial {
     inner: Material,
@@ -52,13 +55,33 @@ impl PyMaterial {
 #[pymethods]
 impl PyMaterial {
     /// Read a material JSON file (the original HYLC format).
+    ///
+    /// Parameters
+    /// ----------
+    /// path : path-like
+    ///     The material file.
+    ///
+    /// Returns
+    /// -------
+    /// Material
+    ///
+    /// Raises
+    /// ------
+    /// FileNotFoundError
+    ///     The file does not exist.
+    /// MaterialError
+    ///     The file is not a valid material (the message names the field).
     #[staticmethod]
     fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
         let inner = detached(py, || Ok(Material::load(&path)?))?;
         Ok(PyMaterial { inner })
     }
 
-    /// The embedded default material (`hylc material default`).
+    /// The embedded default material (``hylc material default``).
+    ///
+    /// Returns
+    /// -------
+    /// Material
     #[staticmethod]
     fn default() -> Self {
         PyMaterial {
@@ -67,6 +90,16 @@ impl PyMaterial {
     }
 
     /// Write the material as JSON.
+    ///
+    /// Parameters
+    /// ----------
+    /// path : path-like
+    ///     The file to write.
+    ///
+    /// Raises
+    /// ------
+    /// MaterialError
+    ///     The file cannot be written.
     fn save(&self, path: PathBuf) -> PyResult<()> {
         self.inner.save(&path).map_err(|e| {
             HyError::from_library(Kind::Material, &e)
@@ -87,7 +120,22 @@ impl PyMaterial {
         self.inner.admissible_limits().to_vec()
     }
 
-    /// ψ at each strain: z of shape (6,) gives a float, (N, 6) an (N,) array.
+    /// ψ at each strain.
+    ///
+    /// Parameters
+    /// ----------
+    /// z : array_like
+    ///     (6,) or (N, 6) strains (s_x, s_a, s_y, II00, II01, II11), float64.
+    ///
+    /// Returns
+    /// -------
+    /// float or numpy.ndarray
+    ///     A float for (6,), an (N,) array for (N, 6).
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     Another shape or dtype, a value not finite or outside the admissible range (the row is named).
     fn psi<'py>(&self, py: Python<'py>, z: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
         let (z, lead) = Self::strains(z)?;
         let v = each(py, &self.inner, &z, |r| r.value)?;
@@ -97,7 +145,22 @@ impl PyMaterial {
         Ok(shaped(py, v, &lead).into_any())
     }
 
-    /// ∇ψ at each strain: (6,) or (N, 6).
+    /// ∇ψ at each strain.
+    ///
+    /// Parameters
+    /// ----------
+    /// z : array_like
+    ///     (6,) or (N, 6) strains.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     (6,) or (N, 6).
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     As :meth:`psi`.
     fn gradient<'py>(&self, py: Python<'py>, z: &Bound<'py, PyAny>) -> PyResult<Array<'py>> {
         let (z, mut lead) = Self::strains(z)?;
         let v = each(py, &self.inner, &z, |r| r.grad)?;
@@ -105,7 +168,22 @@ impl PyMaterial {
         Ok(shaped(py, v.into_iter().flatten().collect(), &lead))
     }
 
-    /// ∇²ψ at each strain: (6, 6) or (N, 6, 6).
+    /// ∇²ψ at each strain.
+    ///
+    /// Parameters
+    /// ----------
+    /// z : array_like
+    ///     (6,) or (N, 6) strains.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     (6, 6) or (N, 6, 6).
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     As :meth:`psi`.
     fn hessian<'py>(&self, py: Python<'py>, z: &Bound<'py, PyAny>) -> PyResult<Array<'py>> {
         let (z, mut lead) = Self::strains(z)?;
         let v = each(py, &self.inner, &z, |r| r.hess)?;
@@ -118,6 +196,21 @@ impl PyMaterial {
     }
 
     /// (ψ, ∇ψ, ∇²ψ) at each strain in one pass.
+    ///
+    /// Parameters
+    /// ----------
+    /// z : array_like
+    ///     (6,) or (N, 6) strains.
+    ///
+    /// Returns
+    /// -------
+    /// tuple
+    ///     As :meth:`psi`, :meth:`gradient` and :meth:`hessian` return them.
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     As :meth:`psi`.
     fn eval<'py>(
         &self,
         py: Python<'py>,
@@ -162,11 +255,40 @@ impl PyMaterial {
     }
 }
 
-/// Fit a material to a sample file (Algorithm C5, as `hylc fit SAMPLES`): writes the material JSON (`out`,
-/// default SAMPLES with extension .material.json) and the JSON fit report (`report`, default .fit.json), PNG
-/// plots only when `plots` (a folder) is given. `preset` is the fit's settings as `hylc fit --preset` takes them
-/// (`covering`, the default and `hylc run`'s; `design`; `design-stockinette`); `knots_1d` and `knots_2d` change
-/// the preset's knot counts. Returns (Material, report dict).
+/// Fit a material to a sample file (Algorithm C5), as ``hylc fit SAMPLES`` does.
+///
+/// Parameters
+/// ----------
+/// samples : path-like
+///     A sample file made by :func:`sample` or ``hylc sample`` (its sidecar gives the plan and the density).
+/// out : path-like, optional
+///     The material JSON to write (default SAMPLES with extension ``.material.json``).
+/// report : path-like, optional
+///     The JSON fit report to write (default ``.fit.json``).
+/// plots : path-like, optional
+///     A folder for the PNG plots (none without it).
+/// plan : str, optional
+///     The plan (name or file) when the sample file has no sidecar.
+/// density : float, optional
+///     The areal density (kg/m²) when the sample file has no sidecar.
+/// preset : {"covering", "design", "design-stockinette"}, default "covering"
+///     The fit's settings, as ``hylc fit --preset`` takes them (``covering`` is ``hylc run``'s).
+/// knots_1d, knots_2d : int, optional
+///     The preset's knot counts changed.
+///
+/// Returns
+/// -------
+/// tuple of (Material, FitReport)
+///     The fitted material and the fit report (the content of the report file).
+///
+/// Raises
+/// ------
+/// FileNotFoundError
+///     The sample file does not exist.
+/// ValueError
+///     An unknown preset; a sample file without samples.
+/// FitError
+///     The fit failed.
 #[pyfunction]
 #[pyo3(signature = (samples, out=None, report=None, plots=None, plan=None, density=None, preset="covering", knots_1d=None, knots_2d=None))]
 #[allow(clippy::too_many_arguments)]

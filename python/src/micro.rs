@@ -27,12 +27,39 @@ fn strain_of(z: &[f64]) -> MacroStrain {
 }
 
 /// The periodic yarn problem of one pattern with yarn parameters and the solver's stopping rules.
+///
+/// Parameters
+/// ----------
+/// pattern : Pattern, str or path-like
+///     A Pattern, a ``.pyp`` file or a generated kind (plain, twill, satin, basket, stockinette).
+/// yarn : dict, path-like or None
+///     Yarn parameters: a dict (missing keys take the defaults, :func:`yarn_defaults`), a yarn JSON file, or
+///     None for the defaults.
+/// tolerance : float, default 1e-8
+///     Force tolerance relative to the stretching stiffness (``hylc solve --tolerance``).
+/// max_steps : int, default 2000
+///     Newton step limit.
+/// time_limit : float, optional
+///     Wall-time limit per solve (s).
+/// quadrature : int, optional
+///     Gauss points per segment of the contact quadrature (default the yarn's, 4).
+/// inertia : bool, default True
+///     The inertia-controlled Newton steps; False is ``hylc solve --no-inertia`` (the design's shift rule).
+///
+/// Raises
+/// ------
+/// ValueError
+///     A bad yarn parameter, tolerance or quadrature; a pattern argument of another type.
+/// FileNotFoundError
+///     A pattern or yarn file that does not exist.
+/// PatternError
+///     A pattern file that is not valid.
 #[pyclass(module = "hylc", name = "MicroProblem", frozen)]
 pub struct PyMicroProblem {
     problem: Arc<MicroProblem>,
 }
 
-/// The result of one micro solve.
+/// The result of one micro solve (:meth:`MicroProblem.solve`): its status, Ψ̄, state and derivatives.
 #[pyclass(module = "hylc", name = "Solution", frozen)]
 pub struct PySolution {
     problem: Arc<MicroProblem>,
@@ -54,10 +81,7 @@ fn positions_of(problem: &MicroProblem, sol: &Solution) -> Vec<[f64; 3]> {
 
 #[pymethods]
 impl PyMicroProblem {
-    /// `pattern`: a Pattern, a `.pyp` path or a generated kind; `yarn`: a dict (missing keys take the defaults,
-    /// `hylc.yarn_defaults()`), a yarn JSON path or None; `tolerance`, `max_steps`, `time_limit`: the stopping
-    /// rules of `hylc solve`; `quadrature`: Gauss points per segment of the contact quadrature; `inertia`: the
-    /// inertia-controlled Newton steps (`False` = `hylc solve --no-inertia`, the design's rule).
+    /// See the class.
     #[new]
     #[pyo3(signature = (pattern, yarn=None, *, tolerance=1e-8, max_steps=2000, time_limit=None, quadrature=None, inertia=true))]
     fn new(
@@ -113,8 +137,26 @@ impl PyMicroProblem {
         4 * self.problem.pattern.len()
     }
 
-    /// Solve at strain `z` (3 numbers s_x, s_a, s_y or 5 with II00, II11), from the reference state or from
-    /// `start` (a previous Solution: a warm start). The GIL is released during the solve.
+    /// Solve at one strain, from the reference state or from a previous solution (a warm start).
+    ///
+    /// Parameters
+    /// ----------
+    /// z : array_like
+    ///     3 numbers (s_x, s_a, s_y) or 5 (with II00, II11 in 1/m).
+    /// start : Solution, optional
+    ///     A previous solution of this problem to start from.
+    ///
+    /// Returns
+    /// -------
+    /// Solution
+    ///     Converged or not (``status``); the GIL is released during the solve.
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     A strain of another shape, not finite or outside the admissible range.
+    /// MicroError
+    ///     The solve could not run.
     #[pyo3(signature = (z, start=None))]
     fn solve(
         &self,
@@ -139,11 +181,27 @@ impl PyMicroProblem {
         })
     }
 
-    /// Solve at every row of `z` ((N, 3) or (N, 5)). `chain=False`: every strain from the reference state, in
-    /// parallel (each result equals `solve(z[i])`); `chain=True`: in order, each from the previous result (as
-    /// `hylc solve --no-predictor --z … --z …`). Returns a dict of arrays: `status` (list of str), `converged`
-    /// (N,), `psi` (N,; NaN when not converged), `stress` (N, 5; NaN when not available), `steps`, `gradient_norm`,
-    /// `time` (N,), `positions` (N, vertices, 3). The GIL is released during the solves.
+    /// Solve at every row of ``z``.
+    ///
+    /// Parameters
+    /// ----------
+    /// z : array_like
+    ///     (N, 3) or (N, 5) strains.
+    /// chain : bool, default False
+    ///     False: every strain from the reference state, in parallel (each result equals ``solve(z[i])``);
+    ///     True: in order, each from the previous result (as ``hylc solve --no-predictor --z … --z …``).
+    ///
+    /// Returns
+    /// -------
+    /// BatchResult
+    ///     ``status`` (list of str), ``converged`` (N,), ``psi`` (N,; NaN when not converged), ``stress`` (N, 5;
+    ///     NaN when not available), ``steps``, ``gradient_norm``, ``time`` (N,), ``positions`` (N, vertices,
+    ///     3). The GIL is released during the solves.
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     Strains of another shape or dtype, not finite or outside the admissible range.
     #[pyo3(signature = (z, chain=false))]
     fn solve_batch<'py>(
         &self,
@@ -206,10 +264,26 @@ impl PyMicroProblem {
         Ok(d)
     }
 
-    /// Ψ̄ at `z` and its derivatives, as `hylc sensitivity` computes them (solved from the reference state; an
-    /// error when the solve does not converge): a dict with `psi`, `steps`, `stress` (∂Ψ̄/∂z, 5), `dpsi_dtheta`
-    /// (6, the parameters of `parameter_names`), `components` and `d2psi_dz2` (k × k), `dy_dz` (k, dofs) and
-    /// `dy_dtheta` (6, dofs).
+    /// Ψ̄ at ``z`` and its derivatives, as ``hylc sensitivity`` computes them (solved from the reference state).
+    ///
+    /// Parameters
+    /// ----------
+    /// z : array_like
+    ///     3 or 5 numbers, as :meth:`solve` takes them.
+    ///
+    /// Returns
+    /// -------
+    /// Sensitivities
+    ///     ``psi``, ``steps``, ``stress`` (∂Ψ̄/∂z, 5), ``dpsi_dtheta`` (6, the parameters of
+    ///     ``hylc.PARAMETERS``), ``components`` and ``d2psi_dz2`` (k, k), ``dy_dz`` (k, dofs) and ``dy_dtheta``
+    ///     (6, dofs).
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     A bad strain.
+    /// MicroError
+    ///     The solve did not converge.
     fn sensitivities<'py>(
         &self,
         py: Python<'py>,
@@ -320,23 +394,53 @@ impl PySolution {
         PyArray1::from_vec(py, self.sol.state.y.clone())
     }
 
-    /// The homogenized stress ∂Ψ̄/∂z (5: s_x, s_a, s_y, II00, II11; J/m² per unit strain), NaN for a bending
-    /// component not available under bending along the other axis.
+    /// The homogenized stress ∂Ψ̄/∂z.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     (5,): s_x, s_a, s_y, II00, II11 (J/m² per unit strain), NaN for a bending component not available
+    ///     under bending along the other axis.
+    ///
+    /// Raises
+    /// ------
+    /// MicroError
+    ///     The derivatives could not be computed.
     fn stress<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let (problem, sol) = (&self.problem, &self.sol);
         let s = detached(py, || stress_of(problem, sol))?;
         Ok(PyArray1::from_vec(py, s.to_vec()))
     }
 
-    /// ∂Ψ̄/∂θ for θ = (young, shear, bend_twist_factor, contact_stiffness, contact_radius_factor, radius) (J/m²
-    /// per unit parameter); needs a converged solve.
+    /// ∂Ψ̄/∂θ of the yarn parameters (envelope theorem).
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     (6,): θ = ``hylc.PARAMETERS`` (young, shear, bend_twist_factor, contact_stiffness,
+    ///     contact_radius_factor, radius), J/m² per unit parameter.
+    ///
+    /// Raises
+    /// ------
+    /// MicroError
+    ///     The solve did not converge (Ψ̄ needs an equilibrium).
     fn parameter_derivatives<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let (problem, sol) = (&self.problem, &self.sol);
         let d = detached(py, || Ok(parameter_derivatives(problem, sol)?))?;
         Ok(PyArray1::from_vec(py, d.to_vec()))
     }
 
-    /// (components, d²Ψ̄/dz² (k, k), dy*/dz (k, dofs)) over the strain components of the state's family.
+    /// The second derivatives of Ψ̄ in the strain and the equilibrium's derivative in it.
+    ///
+    /// Returns
+    /// -------
+    /// tuple of (list of str, numpy.ndarray, numpy.ndarray)
+    ///     The strain components of the state's family (k of them), d²Ψ̄/dz² (k, k) and dy*/dz (k, dofs).
+    ///
+    /// Raises
+    /// ------
+    /// MicroError
+    ///     The solve did not converge.
     fn strain_stiffness<'py>(
         &self,
         py: Python<'py>,
@@ -358,7 +462,17 @@ impl PySolution {
         Ok((names, shaped(py, hess, &[k, k]), shaped(py, dy, &[k, nd])))
     }
 
-    /// dy*/dθ (6, dofs), one row per parameter of `parameter_derivatives`; needs a converged solve.
+    /// The equilibrium's derivative in the yarn parameters.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     dy*/dθ (6, dofs), one row per parameter of :meth:`parameter_derivatives`.
+    ///
+    /// Raises
+    /// ------
+    /// MicroError
+    ///     The solve did not converge.
     fn equilibrium_sensitivities<'py>(&self, py: Python<'py>) -> PyResult<Array<'py>> {
         let (problem, sol) = (&self.problem, &self.sol);
         let dy = detached(py, || Ok(equilibrium_sensitivities(problem, sol)?))?;
@@ -367,7 +481,17 @@ impl PySolution {
         Ok(shaped(py, dy.into_iter().flatten().collect(), &[rows, nd]))
     }
 
-    /// Every derivative at once (the dict of `MicroProblem.sensitivities`).
+    /// Every derivative at once.
+    ///
+    /// Returns
+    /// -------
+    /// Sensitivities
+    ///     The dict of :meth:`MicroProblem.sensitivities`.
+    ///
+    /// Raises
+    /// ------
+    /// MicroError
+    ///     The solve did not converge.
     fn derivatives<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         self.all_derivatives(py)
     }

@@ -11,6 +11,9 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 /// A periodic yarn pattern (one tile): vertex positions, yarns, periods and radius.
+///
+/// Made by :func:`load_pattern`, :func:`read_pyp`, :func:`generate` or :func:`reference_state`; ``len(p)`` is
+/// the number of vertices (= edges).
 #[pyclass(module = "hylc", name = "Pattern", frozen)]
 #[derive(Clone)]
 pub struct PyPattern {
@@ -106,14 +109,30 @@ impl PyPattern {
         self.inner.yarns()
     }
 
-    /// Write the pattern as a `.pyp` file (exact round trip).
+    /// Write the pattern as a ``.pyp`` file (exact round trip).
+    ///
+    /// Parameters
+    /// ----------
+    /// path : path-like
+    ///     The file to write.
+    ///
+    /// Raises
+    /// ------
+    /// PatternError
+    ///     The file cannot be written.
     fn save(&self, path: PathBuf) -> PyResult<()> {
         self.inner.save_pyp(&path).map_err(HyError::from)?;
         Ok(())
     }
 
-    /// The summary `hylc pattern FILE` prints, as a dict: vertices, periods, radius, per-yarn vertex counts and
-    /// rest lengths, total rest and current yarn length, notes.
+    /// The summary ``hylc pattern FILE`` prints, as a dict.
+    ///
+    /// Returns
+    /// -------
+    /// PatternSummary
+    ///     ``vertices``, ``periods``, ``radius``, ``yarns`` (per yarn ``vertices``, ``first``,
+    ///     ``rest_length``), ``crossing_x``, ``crossing_y`` (edges crossing the tile's sides),
+    ///     ``total_rest_length``, ``total_current_length`` and ``notes``.
     fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let p = &self.inner;
         let d = PyDict::new(py);
@@ -151,8 +170,26 @@ impl PyPattern {
     }
 }
 
-/// Load a pattern as the micro commands do: a `.pyp` file (used at the periods its rest lengths imply; `notes`
-/// says when they were replaced) or a generated kind (plain, twill, satin, basket, stockinette).
+/// Load a pattern as the micro commands do.
+///
+/// Parameters
+/// ----------
+/// pattern : str or path-like
+///     A ``.pyp`` file (used at the periods its rest lengths imply; ``notes`` says when they were replaced) or
+///     a generated kind (plain, twill, satin, basket, stockinette).
+///
+/// Returns
+/// -------
+/// Pattern
+///
+/// Raises
+/// ------
+/// FileNotFoundError
+///     A ``.pyp`` file that does not exist.
+/// PatternError
+///     A file that is not a valid pattern.
+/// ValueError
+///     Neither a file nor a generated kind.
 #[pyfunction]
 pub fn load_pattern(py: Python<'_>, pattern: PathBuf) -> PyResult<PyPattern> {
     let arg = pattern.display().to_string();
@@ -161,7 +198,24 @@ pub fn load_pattern(py: Python<'_>, pattern: PathBuf) -> PyResult<PyPattern> {
     Ok(PyPattern::new(loaded.pattern, &arg, notes))
 }
 
-/// Read a `.pyp` file strictly, as `hylc pattern FILE` does (its checks' warnings are in `notes`).
+/// Read a ``.pyp`` file strictly, as ``hylc pattern FILE`` does.
+///
+/// Parameters
+/// ----------
+/// path : path-like
+///     The ``.pyp`` file.
+///
+/// Returns
+/// -------
+/// Pattern
+///     At the file's periods; its checks' warnings are in ``notes``.
+///
+/// Raises
+/// ------
+/// FileNotFoundError
+///     The file does not exist.
+/// PatternError
+///     The file is not a valid pattern (the message names the line).
 #[pyfunction]
 pub fn read_pyp(py: Python<'_>, path: PathBuf) -> PyResult<PyPattern> {
     let (p, warnings) = detached(py, || Ok(hylc::pattern::Pattern::load_pyp(&path)?))?;
@@ -169,8 +223,27 @@ pub fn read_pyp(py: Python<'_>, path: PathBuf) -> PyResult<PyPattern> {
     Ok(PyPattern::new(p, &path.display().to_string(), notes))
 }
 
-/// Generate a pattern (`hylc generate KIND`): `n` the twill repeat (4), satin repeat (5) or basket group size
-/// (2); `step` the satin move (2); `vertices_per_radius` vertices per yarn radius of arclength.
+/// Generate a pattern, as ``hylc generate KIND`` does.
+///
+/// Parameters
+/// ----------
+/// kind : str
+///     plain, twill, satin, basket or stockinette.
+/// n : int, optional
+///     The twill repeat (4), satin repeat (5) or basket group size (2).
+/// step : int, optional
+///     The satin move (2).
+/// vertices_per_radius : float, default 1.0
+///     Vertices per yarn radius of arclength.
+///
+/// Returns
+/// -------
+/// Pattern
+///
+/// Raises
+/// ------
+/// PatternError
+///     An unknown kind or bad parameters.
 #[pyfunction]
 #[pyo3(signature = (kind, n=None, step=None, vertices_per_radius=1.0))]
 pub fn generate(
@@ -191,9 +264,32 @@ pub fn generate(
     Ok(PyPattern::new(p, kind, Vec::new()))
 }
 
-/// The reference state of a pattern (Algorithm C1: stress-free state, tension, zero-stress periods, centring),
-/// as `hylc reference` computes it. `construction` is "knitted" or "woven" (generated kinds know theirs; a file
-/// needs it); `equilibrate_only` skips the stress-free state and the tension. Returns (pattern, report dict).
+/// The reference state of a pattern (Algorithm C1), as ``hylc reference`` computes it.
+///
+/// The stress-free state, the tension, the zero-stress periods and the centring.
+///
+/// Parameters
+/// ----------
+/// pattern : Pattern, str or path-like
+///     A Pattern, a ``.pyp`` file or a generated kind.
+/// construction : {"knitted", "woven"}, optional
+///     Selects the tension factors; generated kinds know theirs, a file needs it.
+/// yarn : dict, path-like or None
+///     Yarn parameters (as :class:`MicroProblem` takes them).
+/// equilibrate_only : bool, default False
+///     Skip the stress-free state and the tension.
+///
+/// Returns
+/// -------
+/// tuple of (Pattern, dict)
+///     The reference state and C1's report (``psi``, ``periods_out``, ...).
+///
+/// Raises
+/// ------
+/// ValueError
+///     An unknown construction, or a file without one.
+/// MicroError
+///     A solve of C1 failed.
 #[pyfunction]
 #[pyo3(signature = (pattern, construction=None, yarn=None, equilibrate_only=false))]
 pub fn reference_state<'py>(

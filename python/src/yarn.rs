@@ -47,20 +47,56 @@ pub fn yarn_dict<'py>(py: Python<'py>, m: &YarnMaterial) -> PyResult<Bound<'py, 
     crate::convert::json_to_py(py, &serde_json::to_value(m).expect("serialises"))
 }
 
-/// The default yarn parameters as a dict (`hylc yarn`).
+/// The default yarn parameters (``hylc yarn``).
+///
+/// Returns
+/// -------
+/// dict
+///     Every key of the yarn JSON (``young``, ``shear``, ``bend_twist_factor``, ``radius``, ``density``,
+///     ``contact_stiffness``, ``contact_quadrature``, ``contact_exclusion``, ``contact_radius_factor``,
+///     ``bending``).
 #[pyfunction]
 pub fn yarn_defaults(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
     yarn_dict(py, &YarnMaterial::default())
 }
 
-/// Read a yarn JSON file (every key required) into a dict.
+/// Read a yarn JSON file (every key required).
+///
+/// Parameters
+/// ----------
+/// path : path-like
+///     The yarn file.
+///
+/// Returns
+/// -------
+/// dict
+///     The parameters, as :func:`yarn_defaults` gives them.
+///
+/// Raises
+/// ------
+/// FileNotFoundError
+///     The file does not exist.
+/// ValueError
+///     A missing, unknown or invalid key.
 #[pyfunction]
 pub fn load_yarn<'py>(py: Python<'py>, path: std::path::PathBuf) -> PyResult<Bound<'py, PyAny>> {
     let m = YarnMaterial::load_json(&path).map_err(HyError::from)?;
     yarn_dict(py, &m)
 }
 
-/// Write yarn parameters (a dict; missing keys take the defaults) as a yarn JSON file for `--yarn FILE`.
+/// Write yarn parameters as a yarn JSON file (for ``--yarn FILE``).
+///
+/// Parameters
+/// ----------
+/// yarn : dict
+///     Yarn parameters; missing keys take the defaults.
+/// path : path-like
+///     The file to write.
+///
+/// Raises
+/// ------
+/// ValueError
+///     An unknown or invalid key, or the file cannot be written.
 #[pyfunction]
 pub fn save_yarn(yarn: &Bound<'_, PyAny>, path: std::path::PathBuf) -> PyResult<()> {
     let m = yarn_of(Some(yarn))?;

@@ -1,5 +1,5 @@
-"""Materials from Python against the CLI, (N, 6) batches against single calls, derivatives against finite
-differences, fitting against `hylc fit`."""
+"""Materials from Python against the command line's stored values, (N, 6) batches against single calls, derivatives
+against finite differences, fitting against the files it writes and its presets."""
 
 import json
 
@@ -19,18 +19,15 @@ def strains(n, seed=1):
     return z
 
 
-def test_values_equal_the_cli(cli_json):
+def test_values_equal_the_cli(expected):
     m = hylc.Material.default()
+    e = expected["material_default"]
     z = strains(5)
-    args = ["material", "default", "--json"]
-    for row in z:
-        args += ["--z", ",".join(repr(float(v)) for v in row)]
-    records = cli_json(*args)
+    np.testing.assert_array_equal(z, e["z"])
     psi, grad, hess = m.eval(z)
-    for i, r in enumerate(records):
-        assert psi[i] == r["psi"]
-        assert list(grad[i]) == r["grad"]
-        assert hess[i].tolist() == r["hess"]
+    np.testing.assert_allclose(psi, e["psi"], rtol=1e-13, atol=0)
+    np.testing.assert_allclose(grad, e["grad"], rtol=1e-12, atol=1e-300)
+    np.testing.assert_allclose(hess, e["hess"], rtol=1e-12, atol=1e-300)
 
 
 def test_batch_equals_single_calls():
@@ -62,15 +59,19 @@ def test_gradient_and_hessian_against_finite_differences():
         np.testing.assert_allclose(hess[:, :, k], fd2, rtol=1e-4, atol=1e-4)
 
 
-def test_save_and_load_round_trip(tmp_path, cli):
+def test_save_and_load_round_trip(tmp_path, expected):
     m = hylc.Material.default()
     path = tmp_path / "m.json"
     m.save(path)
-    cli("material", "default", "--write", tmp_path / "cli.json")
-    assert json.loads(path.read_text()) == json.loads((tmp_path / "cli.json").read_text())
+    saved = json.loads(path.read_text())
+    assert sorted(saved) == expected["material_default"]["keys"]
+    assert saved["density"] == expected["material_default"]["density"]
     back = hylc.Material.load(path)
+    back.save(tmp_path / "again.json")
+    assert (tmp_path / "again.json").read_text() == path.read_text()
     z = strains(10)
     np.testing.assert_array_equal(back.psi(z), m.psi(z))
+    np.testing.assert_allclose(back.psi(strains(5)), expected["material_default"]["psi"], rtol=1e-13)
 
 
 def test_bad_input_raises():
@@ -91,32 +92,38 @@ def test_bad_input_raises():
         m.psi("strain")
 
 
-def test_bad_material_file_raises_material_error(tmp_path, cli):
+def test_bad_material_file_raises_material_error(tmp_path, expected):
     path = tmp_path / "bad.json"
     path.write_text('{"density": 0.2}')
     with pytest.raises(hylc.MaterialError) as e:
         hylc.Material.load(path)
-    err = cli("material", path, "--z", "0,0,0,0,0,0", check=False).stderr.strip()
-    assert err == f"error: {e.value}"
+    assert f"error: {e.value}" == expected["bad_material_error"].replace("{path}", str(path))
 
 
-def test_fit_equals_the_cli(quick_samples, tmp_path, cli):
-    material, report = hylc.fit(quick_samples, out=tmp_path / "py.material.json", report=tmp_path / "py.fit.json")
-    cli("fit", quick_samples, "--out", tmp_path / "cli.material.json", "--report", tmp_path / "cli.fit.json", "--no-plots")
-    assert (tmp_path / "py.material.json").read_text() == (tmp_path / "cli.material.json").read_text()
-    assert report["samples"] == json.loads((tmp_path / "cli.fit.json").read_text())["samples"]
+def test_fit_equals_its_files_and_is_deterministic(quick_samples, tmp_path):
+    material, report = hylc.fit(quick_samples, out=tmp_path / "a.material.json", report=tmp_path / "a.fit.json")
+    hylc.fit(quick_samples, out=tmp_path / "b.material.json", report=tmp_path / "b.fit.json")
+    a = json.loads((tmp_path / "a.material.json").read_text())
+    b = json.loads((tmp_path / "b.material.json").read_text())
+    a["meta"].pop("samples", None), b["meta"].pop("samples", None)
+    assert a == b
+    stored = json.loads((tmp_path / "a.fit.json").read_text())
+    assert report["samples"] == stored["samples"]
+    # the fit read the sidecar hylc.sample wrote: the pattern, the plan and the yarn
+    assert a["meta"]["pattern"] == "plain" and a["meta"]["yarn"] == hylc.yarn_defaults()
     z = strains(10)
-    np.testing.assert_array_equal(material.psi(z), hylc.Material.load(tmp_path / "cli.material.json").psi(z))
+    np.testing.assert_array_equal(material.psi(z), hylc.Material.load(tmp_path / "a.material.json").psi(z))
     with pytest.raises(FileNotFoundError, match="samples: missing.jsonl"):
         hylc.fit("missing.jsonl")
 
 
-def test_fit_presets_equal_the_cli_and_bad_names_raise(quick_samples, tmp_path, cli):
-    hylc.fit(quick_samples, out=tmp_path / "py.material.json", report=tmp_path / "py.fit.json", preset="design")
-    cli("fit", quick_samples, "--preset", "design", "--out", tmp_path / "cli.material.json", "--report",
-        tmp_path / "cli.fit.json", "--no-plots")
-    assert (tmp_path / "py.material.json").read_text() == (tmp_path / "cli.material.json").read_text()
-    meta = json.loads((tmp_path / "py.material.json").read_text())["meta"]
+def test_fit_presets_and_bad_names_raise(quick_samples, tmp_path):
+    hylc.fit(quick_samples, out=tmp_path / "design.material.json", report=tmp_path / "design.fit.json",
+             preset="design")
+    hylc.fit(quick_samples, out=tmp_path / "covering.material.json", report=tmp_path / "covering.fit.json")
+    meta = json.loads((tmp_path / "design.material.json").read_text())["meta"]
     assert meta["fit options"]["bandwidth_factor"] == 2.0 and meta["fit options"]["compression_residual"] is False
+    covering = json.loads((tmp_path / "covering.material.json").read_text())["meta"]
+    assert covering["fit options"] != meta["fit options"]
     with pytest.raises(ValueError, match="unknown fit preset `fast`"):
         hylc.fit(quick_samples, preset="fast")

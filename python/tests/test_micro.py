@@ -1,6 +1,7 @@
-"""Micro solves from Python against the CLI, batches against single calls, derivatives against finite
-differences, and the GIL released during a solve."""
+"""Micro solves from Python against the records the library's sampler writes (the path of `hylc sample`), batches
+against single calls, derivatives against finite differences, and the GIL released during a solve."""
 
+import json
 import threading
 
 import numpy as np
@@ -11,14 +12,20 @@ import hylc
 STRAINS = [[0.01, 0.0, 0.0], [0.0, 0.05, 0.02], [0.03, 0.0, 0.01, 0.0, 20.0]]
 
 
-def rust_e(x, digits=6):
-    """x as Rust's `{:.6e}` prints it (no exponent padding or plus sign)."""
-    mantissa, exponent = f"{x:.{digits}e}".split("e")
-    return f"{mantissa}e{int(exponent)}"
+def one_ray_plan(component, lo, hi, n):
+    """A plan of one 1D range: `n` samples of strain `component` in [lo, hi], none of the others."""
+    ranges = {k: [-1e-3, 1e-3] for k in ("s_x", "s_a", "s_y", "II00", "II11")}
+    ranges[component] = [lo, hi]
+    return {"ranges": ranges, "count_1d": n, "count_2d": 0, "pairs": [],
+            "counts_1d": [n if k == component else 0 for k in ("s_x", "s_a", "s_y", "II00", "II11")]}
 
 
-def as_cli(z):
-    return ",".join(repr(float(v)) for v in z)
+def records(path):
+    return [json.loads(line) for line in open(path)]
+
+
+def stress_as_record(s):
+    return [None if np.isnan(v) else v for v in s.stress()]
 
 
 @pytest.fixture(scope="module")
@@ -26,46 +33,43 @@ def plain():
     return hylc.MicroProblem("plain")
 
 
-def test_solve_equals_the_cli(plain, cli_json):
-    args = ["solve", "plain", "--cold", "--json"]
-    for z in STRAINS:
-        args += ["--z", as_cli(z)]
-    records = cli_json(*args)
-    assert len(records) == len(STRAINS)
-    for z, r in zip(STRAINS, records):
-        s = plain.solve(z)
+def test_solve_equals_the_sampler_cold(plain, tmp_path):
+    # every sample solved from the reference state, as `hylc sample --cold` does
+    out = tmp_path / "cold.jsonl"
+    hylc.sample("plain", out, one_ray_plan("s_a", -0.1, 0.1, 4), cold=True)
+    rs = records(out)
+    assert len(rs) == 4
+    for r in rs:
+        s = plain.solve(r["z"])
         assert s.status == r["status"]
         assert s.steps == r["steps"]
-        assert s.psi == r["psi"]  # bitwise: the CLI prints shortest round-trip floats
-        stress = s.stress()
-        for k, name in enumerate(hylc.MICRO_STRAIN):
-            expected = r["stress"][name]
-            if expected is None:
-                assert np.isnan(stress[k])
-            else:
-                assert stress[k] == expected
-        assert s.energy == r["energy"]
+        assert s.psi == r["psi"]  # bitwise: the records keep shortest round-trip floats
+        assert stress_as_record(s) == r["stress"]
 
 
-def test_design_rule_equals_the_cli_no_inertia(cli_json):
+def test_design_rule_equals_the_sampler_no_inertia(tmp_path):
     design = hylc.MicroProblem("plain", inertia=False)
-    args = ["solve", "plain", "--cold", "--no-inertia", "--json"]
-    for z in STRAINS:
-        args += ["--z", as_cli(z)]
-    for z, r in zip(STRAINS, cli_json(*args)):
-        s = design.solve(z)
+    out = tmp_path / "design.jsonl"
+    hylc.sample("plain", out, one_ray_plan("s_x", -0.05, 0.1, 3), cold=True, inertia=False)
+    for r in records(out):
+        s = design.solve(r["z"])
         assert (s.status, s.steps, s.psi) == (r["status"], r["steps"], r["psi"])
 
 
-def test_chain_equals_the_cli_without_predictor(plain, cli_json):
-    z = np.array([[0.0, 0.0, 0.0], [0.02, 0.0, 0.0], [0.04, 0.0, 0.0]])
-    args = ["solve", "plain", "--no-predictor", "--json"]
-    for row in z:
-        args += ["--z", as_cli(row)]
-    records = cli_json(*args)
+def test_chain_equals_the_sampler_without_predictor(plain, tmp_path):
+    # a 1D range is two rays solved outward from the sample nearest zero, each warm-started from the previous
+    plan = one_ray_plan("s_x", -0.02, 0.06, 7)
+    out = tmp_path / "chain.jsonl"
+    hylc.sample("plain", out, plan, predictor="none")
+    by_z = {r["z"][0]: r for r in records(out)}
+    xs = hylc.plan_samples(plan)["z"][:7, 0]
+    start = int(np.argmin(np.abs(xs)))
+    ray = xs[start:]
+    z = np.zeros((len(ray), 5))
+    z[:, 0] = ray
     batch = plain.solve_batch(z, chain=True)
-    assert list(batch["psi"]) == [r["psi"] for r in records]
-    assert list(batch["steps"]) == [r["steps"] for r in records]
+    assert list(batch["psi"]) == [by_z[x]["psi"] for x in ray]
+    assert list(batch["steps"]) == [by_z[x]["steps"] for x in ray]
 
 
 def test_batch_equals_single_calls(plain):
@@ -103,7 +107,7 @@ def test_stress_against_finite_differences(plain):
         assert s.stress()[k] == pytest.approx(fd, rel=1e-4, abs=1e-4)
 
 
-def test_sensitivities_against_finite_differences_and_the_cli(cli):
+def test_sensitivities_against_finite_differences_and_the_sampler(tmp_path):
     pattern = hylc.generate("plain")
     z = [0.02, 0.0, 0.01]
     yarn = hylc.yarn_defaults()
@@ -132,11 +136,14 @@ def test_sensitivities_against_finite_differences_and_the_cli(cli):
         dz[col] = h
         ds = (p.solve(np.add(z, dz), start=base).stress() - p.solve(np.subtract(z, dz), start=base).stress()) / (2 * h)
         np.testing.assert_allclose(d["d2psi_dz2"][:3, col], ds[:3], rtol=1e-3, atol=1e-2)
-    # the CLI's text (6 significant digits)
-    text = cli("sensitivity", "plain", "--z", as_cli(z)).stdout
-    assert f"Ψ̄ = {rust_e(d['psi'])} J/m²" in text
-    for k, name in enumerate(hylc.PARAMETERS):
-        assert f"∂Ψ̄/∂{name} = {rust_e(d['dpsi_dtheta'][k])}" in text
+    # the sampler's records keep the same ∂Ψ̄/∂θ (`hylc sample --sensitivities`)
+    out = tmp_path / "sens.jsonl"
+    plan = one_ray_plan("s_x", 0.0, 0.02, 2)
+    hylc.sample(pattern, out, plan, cold=True, sensitivities=True)
+    for r in records(out):
+        d = hylc.MicroProblem(pattern).sensitivities(r["z"])
+        assert d["psi"] == r["psi"]
+        np.testing.assert_allclose([r["dpsi_dtheta"][k] for k in hylc.PARAMETERS], d["dpsi_dtheta"], rtol=1e-12)
 
 
 def test_not_converged_raises_for_sensitivities():
@@ -171,13 +178,14 @@ def test_bad_yarn_raises():
         hylc.MicroProblem("plain", quadrature=0)
 
 
-def test_yarn_round_trip(tmp_path, cli):
+def test_yarn_round_trip(tmp_path, expected):
     y = hylc.yarn_defaults()
-    y["contact_stiffness"] = 50.0
     path = tmp_path / "yarn.json"
     hylc.save_yarn(y, path)
+    assert path.read_text() == expected["yarn_defaults_text"]  # `hylc yarn`
+    y["contact_stiffness"] = 50.0
+    hylc.save_yarn(y, path)
     assert hylc.load_yarn(path) == y
-    assert cli("yarn", path).stdout.strip() == path.read_text().strip()
     # the text-valued key of the bending-discretisation variant
     assert y["bending"] == "tan"
     y["bending"] = "sin"

@@ -1,23 +1,25 @@
-"""Patterns, the reference state and cloth scenes from Python against the CLI; bad input raises."""
+"""Patterns and the reference state from Python against the command line's stored files; cloth scenes against the
+files the same call writes; bad input raises."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import hylc
 
+DATA = Path(__file__).resolve().parent / "data"
 
-def test_generate_equals_the_cli(tmp_path, cli):
-    for kind, extra in [("plain", []), ("twill", ["--n", "3"]), ("stockinette", [])]:
-        cli("generate", kind, *extra, "--out", tmp_path / f"{kind}.cli.pyp")
-        n = int(extra[1]) if extra else None
+
+def test_generate_equals_the_cli(tmp_path):
+    for kind, n in [("plain", None), ("twill", 3), ("stockinette", None)]:
         p = hylc.generate(kind, n=n)
         p.save(tmp_path / f"{kind}.py.pyp")
-        assert (tmp_path / f"{kind}.py.pyp").read_bytes() == (tmp_path / f"{kind}.cli.pyp").read_bytes()
+        assert (tmp_path / f"{kind}.py.pyp").read_bytes() == (DATA / f"{kind}.pyp").read_bytes()
 
 
-def test_load_save_and_summary(tmp_path, cli):
+def test_load_save_and_summary(tmp_path):
     p = hylc.generate("plain")
     path = tmp_path / "plain.pyp"
     p.save(path)
@@ -25,38 +27,35 @@ def test_load_save_and_summary(tmp_path, cli):
     np.testing.assert_array_equal(q.positions, p.positions)
     assert q.periods == p.periods and q.radius == p.radius
     s = q.summary()
-    text = cli("pattern", path).stdout
-    assert f"vertices: {s['vertices']} " in text
-    assert f"yarns: {len(s['yarns'])}" in text
+    # `hylc pattern plain.pyp`: 40 vertices in 4 yarns of 10, 2 edges crossing each side, rest length 4.357118e-2 m
+    assert s["vertices"] == 40 and [y["vertices"] for y in s["yarns"]] == [10] * 4
+    assert (s["crossing_x"], s["crossing_y"]) == (2, 2)
+    assert f"{s['total_rest_length']:.6e}" == "4.357118e-02"
     assert len(p) == 40 and p.positions.shape == (40, 3)
     assert sorted(v for y in p.yarns() for v in y) == list(range(40))
     r = hylc.load_pattern(str(path))
     np.testing.assert_array_equal(r.positions, p.positions)
 
 
-def test_reference_state_equals_the_cli(tmp_path, cli):
-    cli("reference", "plain", "--out", tmp_path / "cli.pyp", "--json", tmp_path / "cli.json")
+def test_reference_state_equals_the_cli(tmp_path, expected):
     q, report = hylc.reference_state("plain")
     q.save(tmp_path / "py.pyp")
-    assert (tmp_path / "py.pyp").read_bytes() == (tmp_path / "cli.pyp").read_bytes()
-    expected = json.loads((tmp_path / "cli.json").read_text())
-    assert report["psi"] == expected["psi"]
-    assert report["periods_out"] == expected["periods_out"]
+    assert (tmp_path / "py.pyp").read_bytes() == (DATA / "plain.reference.pyp").read_bytes()
+    assert report["psi"] == pytest.approx(expected["reference_plain"]["psi"], rel=1e-12)
+    assert report["periods_out"] == pytest.approx(expected["reference_plain"]["periods_out"], rel=1e-12)
 
 
-def test_pattern_errors_have_the_cli_messages(tmp_path, cli):
+def test_pattern_errors_have_the_cli_messages(tmp_path, expected):
     with pytest.raises(FileNotFoundError, match="missing.pyp"):
         hylc.load_pattern("missing.pyp")
     with pytest.raises(hylc.PatternError) as e:
         hylc.generate("jersey")
-    err = cli("generate", "jersey", check=False).stderr.strip()
-    assert err == f"error: {e.value}"
+    assert f"error: {e.value}" == expected["generate_jersey_error"]
     bad = tmp_path / "bad.pyp"
     bad.write_text("*not a pattern\n")
     with pytest.raises(hylc.PatternError) as e:
         hylc.read_pyp(bad)
-    err = cli("pattern", bad, check=False).stderr.strip()
-    assert err == f"error: {e.value}"
+    assert f"error: {e.value}" == expected["bad_pyp_error"].replace("{path}", str(bad))
     with pytest.raises(ValueError, match="construction"):
         hylc.reference_state("plain", construction="crochet")
     with pytest.raises(ValueError, match="pass --construction"):
@@ -71,22 +70,47 @@ def _saved_plain(tmp_path):
     return str(path)
 
 
-def test_simulate_equals_the_cli_log(tmp_path, cli):
-    out = tmp_path / "cli"
-    cli("simulate", "stretch-x", "--duration", "0.05", "--out", out, "--quiet")
-    log = [json.loads(line) for line in (out / "log.jsonl").read_text().splitlines()]
-    r = hylc.simulate("stretch-x", duration=0.05)
+def _log(folder):
+    return [json.loads(line) for line in (folder / "log.jsonl").read_text().splitlines()]
+
+
+def test_simulate_equals_its_log(tmp_path):
+    out = tmp_path / "run"
+    r = hylc.simulate("stretch-x", duration=0.05, out=out)
+    log = _log(out)
     assert len(r["step"]) == len(log) == r["summary"]["steps"]
     for key in ["time", "newton", "residual", "energy_elastic", "energy_kinetic", "energy_gravity", "rejected",
                 "error_estimate"]:
-        np.testing.assert_allclose(r[key], [e[key] for e in log], rtol=1e-9, atol=1e-300)
-    np.testing.assert_allclose(r["strain_max"], [e["strain_max"] for e in log], rtol=1e-9, atol=1e-15)
+        np.testing.assert_array_equal(r[key], [e[key] for e in log])
+    np.testing.assert_array_equal(r["strain_max"], [e["strain_max"] for e in log])
     for name, forces in r["handle_forces"].items():
         expected = [dict(map(tuple, [(h[0], h[1]) for h in e["handle_forces"]]))[name] for e in log]
-        np.testing.assert_allclose(forces, expected, rtol=1e-8, atol=1e-12)
+        np.testing.assert_array_equal(forces, expected)
     assert r["positions"].shape == (r["summary"]["vertices"], 3)
     assert r["triangles"].shape == (r["summary"]["triangles"], 3) and r["triangles"].dtype == np.int64
     assert r["triangles"].max() < r["summary"]["vertices"]
+    np.testing.assert_allclose(r["positions"], _obj_vertices(out / f"frame_{len(log):04d}.obj"), rtol=0, atol=1e-12)
+    # without `out` the run is the same
+    again = hylc.simulate("stretch-x", duration=0.05)
+    np.testing.assert_array_equal(again["positions"], r["positions"])
+
+
+def test_a_scene_dict_equals_its_file(tmp_path):
+    scene = hylc.load_scene("stretch-x")
+    assert scene["name"] == "stretch-x" and scene["material"] == "default"
+    scene.update(duration=0.05)
+    path = tmp_path / "stretch.json"
+    path.write_text(json.dumps(scene))
+    assert hylc.load_scene(path) == scene == hylc.load_scene(scene)
+    from_file, from_dict = hylc.simulate(str(path)), hylc.simulate(scene)
+    for key in ["time", "residual", "energy_elastic", "positions"]:
+        np.testing.assert_array_equal(from_dict[key], from_file[key])
+    # the built-in with the same override is the same scene
+    np.testing.assert_array_equal(hylc.simulate("stretch-x", duration=0.05)["positions"], from_dict["positions"])
+    with pytest.raises(hylc.SimulationError, match=r"scene \(a dict\)"):
+        hylc.simulate(dict(scene, dt="soon"))
+    with pytest.raises(ValueError, match="scene: expected"):
+        hylc.simulate(42)
 
 
 def test_simulate_bad_input_raises(tmp_path):
@@ -128,9 +152,9 @@ def test_a_panic_becomes_an_internal_error():
     assert hylc.Material.default().psi([0.0] * 6) == hylc.Material.default().psi(np.zeros(6))
 
 
-def _quasi_static_stretch(tmp_path, cli):
+def _quasi_static_stretch(tmp_path):
     """`stretch-x` made quasi-static and coarse (three load steps), written as a scene file."""
-    s = json.loads(cli("simulate", "stretch-x", "--print").stdout)
+    s = hylc.load_scene("stretch-x")
     s.update(quasi_static=True, duration=0.15, dt=0.05, drag=0.0)
     s["mesh"]["rectangle"]["edge"] = 0.3 / 12
     f = tmp_path / "stretch.json"
@@ -142,17 +166,20 @@ def _obj_vertices(path):
     return np.array([[float(t) for t in line.split()[1:4]] for line in open(path) if line.startswith("v ")])
 
 
-def test_gradient_equals_the_cli_and_the_vjp_equals_a_target(tmp_path, cli):
-    scene = _quasi_static_stretch(tmp_path, cli)
-    cli("gradient", scene, "--observable", "handle-force:right:x", "--out", tmp_path / "cli", "--quiet")
-    expected = json.loads((tmp_path / "cli" / "gradient.json").read_text())
+def test_gradient_equals_its_file_and_the_vjp_equals_a_target(tmp_path):
+    scene = _quasi_static_stretch(tmp_path)
     g = hylc.gradient(scene, observable="handle-force:right:x", out=tmp_path / "py")
+    expected = json.loads((tmp_path / "py" / "gradient.json").read_text())
     assert g["value"] == pytest.approx(expected["value"], rel=1e-12)
     assert g["scene"]["stiffness"] == pytest.approx(expected["scene"]["stiffness"], rel=1e-10)
     assert g["held"]["right"]["keyframes"].shape == (2, 3)
     np.testing.assert_allclose(g["held"]["right"]["keyframes"], expected["held"]["right"]["keyframes"], rtol=1e-10)
     p = g["material"]["coeffs"]["1D"][0]["p"]
     assert isinstance(p, np.ndarray) and np.abs(p).max() > 0
+    # a scene dict gives the same gradient
+    from_dict = hylc.gradient(json.loads(open(scene).read()), observable="handle-force:right:x")
+    assert from_dict["value"] == g["value"]
+    np.testing.assert_array_equal(from_dict["material"]["coeffs"]["1D"][0]["p"], p)
     # the vector–Jacobian product with w = x* − x̂ is the gradient of the target ½|x − x̂|² at x*
     x_hat = _obj_vertices(tmp_path / "py" / "frame_0000.obj")
     x_star = _obj_vertices(tmp_path / "py" / "frame_0003.obj")
@@ -172,29 +199,28 @@ def test_gradient_equals_the_cli_and_the_vjp_equals_a_target(tmp_path, cli):
         hylc.gradient(str(tmp_path / "damped.json"), observable="energy")
 
 
-def test_yarn_chain_equals_the_cli(tmp_path, cli, quick_samples):
+def test_yarn_chain_equals_its_file(tmp_path, quick_samples):
     material = tmp_path / "plain.material.json"
-    cli("fit", quick_samples, "--out", material, "--no-plots")
-    scene = _quasi_static_stretch(tmp_path, cli)
-    cli("gradient", scene, "--observable", "energy", "--material", material, "--samples", quick_samples,
-        "--out", tmp_path / "cli", "--quiet")
-    expected = json.loads((tmp_path / "cli" / "gradient.json").read_text())["yarn"]
-    g = hylc.gradient(scene, observable="energy", material=str(material), samples=quick_samples)
+    hylc.fit(quick_samples, out=material, report=tmp_path / "plain.fit.json")
+    scene = _quasi_static_stretch(tmp_path)
+    g = hylc.gradient(scene, observable="energy", material=str(material), samples=quick_samples, out=tmp_path / "py")
+    expected = json.loads((tmp_path / "py" / "gradient.json").read_text())["yarn"]
     assert list(g["yarn"]) == ["young", "shear", "bend_twist_factor", "contact_stiffness", "contact_radius_factor",
                                "radius"]
     for k, v in expected.items():
-        assert g["yarn"][k] == pytest.approx(v, rel=1e-12, abs=1e-300)
+        assert g["yarn"][k] == v
+    assert any(v != 0 for v in expected.values())
     assert g["yarn_chain"]["reference_state"] == "held fixed"
     with pytest.raises(ValueError, match="yarn needs samples"):
         hylc.gradient(scene, observable="energy", material=str(material), yarn={"young": 1e6})
 
 
-def test_vtu_series_reads_back_with_meshio(tmp_path, cli):
+def test_vtu_series_reads_back_with_meshio(tmp_path):
     meshio = pytest.importorskip("meshio")
     import xml.etree.ElementTree as ET
 
     out = tmp_path / "vtu"
-    cli("simulate", "stretch-x", "--edge", "0.025", "--duration", "0.05", "--format", "vtu", "--out", out, "--quiet")
+    hylc.simulate("stretch-x", edge=0.025, duration=0.05, vtu=True, out=out)
     sets = ET.parse(out / "frames.pvd").getroot().find("Collection").findall("DataSet")
     times = [float(d.get("timestep")) for d in sets]
     assert len(sets) == 4 and times == sorted(times) and times[0] == 0.0

@@ -13,7 +13,10 @@ pub mod starts;
 
 pub use plan::{sample_range, Chain, InPlaneGrid, Plan, PlanError, Sample, Step};
 pub use record::{PerParameter, Record, SampleStart, SampleStatus, StartKind, StartResult};
-pub use run::{merge, parse_shard, read_samples, run_plan, run_plan_with, RunOptions, RunSummary};
+pub use run::{
+    merge, parse_shard, read_samples, run_plan, run_plan_until, run_plan_with, RunOptions,
+    RunSummary,
+};
 pub use starts::{compare, Comparison, Disagreement, Starts};
 
 use std::path::PathBuf;

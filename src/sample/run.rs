@@ -214,6 +214,20 @@ pub fn run_plan_with(
     opts: &RunOptions,
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Result<RunSummary, SampleError> {
+    run_plan_until(problem, plan, out, opts, progress, &AtomicBool::new(false))
+}
+
+/// [`run_plan_with`] that stops early once `cancel` is set (e.g. from another thread on Ctrl-C): every chain ends
+/// after the solve in flight, the records written so far stay in the file (a later run resumes from them), and the
+/// summary counts what was written.
+pub fn run_plan_until(
+    problem: &MicroProblem,
+    plan: &Plan,
+    out: &Path,
+    opts: &RunOptions,
+    progress: &(dyn Fn(usize, usize) + Sync),
+    cancel: &AtomicBool,
+) -> Result<RunSummary, SampleError> {
     let t0 = Instant::now();
     plan.validate()?;
     if opts.cold && opts.starts != Starts::Warm {
@@ -281,6 +295,7 @@ pub fn run_plan_with(
         converged: AtomicUsize::new(0),
         replayed: AtomicUsize::new(0),
         stop: AtomicBool::new(false),
+        cancel,
         failure: Mutex::new(None),
     };
     progress(0, todo);
@@ -366,10 +381,17 @@ pub(super) struct PlanRun<'a> {
     converged: AtomicUsize,
     pub(super) replayed: AtomicUsize,
     pub(super) stop: AtomicBool,
+    /// Set from outside the run ([`run_plan_until`]) to stop it.
+    cancel: &'a AtomicBool,
     failure: Mutex<Option<SampleError>>,
 }
 
 impl PlanRun<'_> {
+    /// Whether the run must stop: a write failed, the limit is reached or the caller cancelled it.
+    pub(super) fn stopped(&self) -> bool {
+        self.stop.load(Ordering::Relaxed) || self.cancel.load(Ordering::Relaxed)
+    }
+
     /// One chain, in order: its unfinished steps and (warm) every step they continue from, each started from the
     /// nearest converged step up the chain.
     fn chain(&self, steps: &[Step]) {
@@ -394,7 +416,7 @@ impl PlanRun<'_> {
         }
         let mut states: Vec<Option<MicroState>> = vec![None; steps.len()];
         for (i, step) in steps.iter().enumerate() {
-            if !need[i] || self.stop.load(Ordering::Relaxed) {
+            if !need[i] || self.stopped() {
                 continue;
             }
             let sample = &self.samples[step.sample];
@@ -653,7 +675,7 @@ impl PlanRun<'_> {
         let mut states: Vec<Option<MicroState>> = vec![None; steps.len()];
         let mut solves: Vec<Vec<Solve>> = Vec::with_capacity(steps.len());
         for (i, step) in steps.iter().enumerate() {
-            if self.stop.load(Ordering::Relaxed) {
+            if self.stopped() {
                 return;
             }
             let sample = &self.samples[step.sample];

@@ -80,6 +80,17 @@ pub fn prepare_noted(
     for w in &warnings {
         on_event(Event::Note(w));
     }
+    override_scene(&mut scene, ov, on_event)?;
+    Ok((scene, dir))
+}
+
+/// Apply the overrides `ov` to a loaded scene (as [`prepare_noted`] does after loading; for a scene built in memory,
+/// e.g. from a JSON value), reporting a duration of 0 as an [`Event::Note`].
+pub fn override_scene(
+    scene: &mut Scene,
+    ov: &Overrides,
+    on_event: &mut dyn FnMut(Event),
+) -> Result<(), WorkflowError> {
     if let Some(m) = &ov.material {
         // a path given on the command line is relative to the working directory
         scene.material = if m == "default" {
@@ -145,7 +156,7 @@ pub fn prepare_noted(
             "warning: duration 0 s: no step is simulated, only frame 0 (the initial state) is written",
         ));
     }
-    Ok((scene, dir))
+    Ok(())
 }
 
 /// The end state of a simulation: its summary, the final positions and the triangles.

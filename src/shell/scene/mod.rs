@@ -643,4 +643,4 @@ mod run;
 mod validate;
 
 pub use builtin::{builtin, BUILTINS, BUILTIN_EDGE, SIDE};
-pub use run::{run, run_with, RunSummary};
+pub use run::{run, run_until, run_with, RunSummary};

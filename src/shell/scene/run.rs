@@ -56,6 +56,22 @@ pub fn run_with(
     out: Option<&Path>,
     mut progress: impl FnMut(&StepReport),
 ) -> Result<RunSummary, ShellError> {
+    run_until(sim, tris, steps, output, out, |r| {
+        progress(r);
+        true
+    })
+}
+
+/// [`run_with`] that stops early when `progress` returns false (e.g. on Ctrl-C): the steps done so far are in the
+/// files, which are flushed, and the summary's `steps` counts them.
+pub fn run_until(
+    sim: &mut Simulation,
+    tris: &[[usize; 3]],
+    steps: usize,
+    output: &OutputSpec,
+    out: Option<&Path>,
+    mut progress: impl FnMut(&StepReport) -> bool,
+) -> Result<RunSummary, ShellError> {
     let io = |e: std::io::Error, what: &Path| ShellError::io(what, "cannot write", e);
     let mut frames = Frames::new(output.vtu);
     let mut forces = match out {
@@ -131,8 +147,12 @@ pub fn run_with(
                     .map_err(|(e, f)| io(e, &f))?;
             }
         }
-        progress(&r);
+        let go_on = progress(&r);
         sum.last = Some(r);
+        if !go_on {
+            sum.steps = k;
+            break;
+        }
     }
     for (mut w, f) in log.into_iter().chain(forces) {
         w.flush().map_err(|e| io(e, &f))?;
