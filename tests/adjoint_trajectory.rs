@@ -318,8 +318,8 @@ fn windy() -> Wind {
     }
 }
 
-/// Stiffness-proportional damping (c = 0.01 s: c/h 1.2 times the elastic Hessian) and air drag, whose Hessians and
-/// faces are lagged at each substep's start, on the stretch over its sphere: reactions included (the lagged terms
+/// Stiffness-proportional damping (c = 0.01 s: c/h 1.2 times the elastic Hessian), air drag and friction (μ = 0.3), whose Hessians and
+/// faces and contacts are lagged at each substep's start, on the stretch over its sphere: reactions included (the lagged terms
 /// couple the held vertices to the free ones).
 #[test]
 fn damped_windy_stretch_matches_reruns() {
@@ -328,6 +328,7 @@ fn damped_windy_stretch_matches_reruns() {
     s.obstacles = sphere([0.16, 0.14, -0.027]);
     s.damping = 0.01;
     s.wind = windy();
+    s.contact.friction = 0.3;
     let n = s.build("scene.json", Path::new(".")).unwrap().0.pattern.n;
     let scalars = [
         Param::Stiffness,
@@ -351,7 +352,8 @@ fn damped_windy_stretch_matches_reruns() {
     compare("damped stretch-x", &s, &obs, &scalars, &extra, 1e-5);
 }
 
-/// Air drag on the drape falling onto its sphere (on top of its linear drag), where the faces turn most. Without
+/// Air drag and friction (μ = 0.3) on the drape falling onto its sphere (on top of its linear drag), where the
+/// faces turn most and the cloth slides over the sphere. Without
 /// damping: damped drapes move the option-(b) projection's bending eigenvalues, several of which hover about zero
 /// (−2e-12 … 2e-10 against 1e-4 in plane for the default material), across zero, and each crossing is a kink of the
 /// damping force; the reruns' J then jitters by ~5e-9 m, and their differences scatter by ±5e-4 at every relative
@@ -362,6 +364,7 @@ fn windy_drape_matches_reruns() {
     let mut s = coarse("drape-x", 0.3 / 8.0);
     s.obstacles = sphere([0.15, 0.15, -0.035]);
     s.wind = windy();
+    s.contact.friction = 0.3;
     let n = s.build("scene.json", Path::new(".")).unwrap().0.pattern.n;
     let scalars = [
         Param::Stiffness,
@@ -370,7 +373,7 @@ fn windy_drape_matches_reruns() {
         Param::Gravity(2),
     ];
     compare(
-        "windy drape-x",
+        "windy drape-x with friction",
         &s,
         &observables(n),
         &scalars,

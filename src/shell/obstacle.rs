@@ -493,6 +493,26 @@ pub fn friction(
     (s * f, g, h)
 }
 
+/// D = μ λ f₀(|T δ|) of [`friction`] with the frozen normal `n` and normal force `lambda` as scalars too, generic
+/// over the scalar (the trajectory adjoint differentiates μᵀ∇_δD with respect to them by forward-mode AD). Where
+/// the tangential displacement vanishes exactly, f₀ = y²/ε (its cubic term has no first or second derivative
+/// there).
+pub fn friction_lagged_reference<D: Real>(n: &[D], lambda: D, mu: f64, eps: f64, delta: &[D]) -> D {
+    let dn = (0..3).fold(c::<D>(0.0), |acc, k| acc + delta[k].clone() * n[k].clone());
+    let y2 = (0..3).fold(c::<D>(0.0), |acc, k| {
+        let u = delta[k].clone() - dn.clone() * n[k].clone();
+        acc + u.clone() * u
+    });
+    let f = if y2.re() == 0.0 {
+        y2 / eps
+    } else if y2.re().sqrt() < eps {
+        y2.clone() / eps - y2.clone() * y2.sqrt() / (3.0 * eps * eps)
+    } else {
+        y2.sqrt() - eps / 3.0
+    };
+    f * lambda * mu
+}
+
 /// Reference implementation of [`friction`] generic over the scalar (for the derivative harness).
 pub fn friction_reference<D: Real>(fc: &FrictionContact, mu: f64, eps: f64, delta: &[D]) -> D {
     let n = fc.n;

@@ -11,7 +11,7 @@ use std::process::ExitCode;
 /// Sensitivities of a scene: dJ/dp of one observable for the scene's stiffness, bending scale, mass and gravity,
 /// every held set's translation and keyframe offsets, every obstacle's translation and every coefficient of the
 /// material, by one adjoint solve at a quasi-static equilibrium or the discrete adjoint of a dynamic run's
-/// implicit Euler substeps (damping and air drag included, not friction; docs/sensitivities.md). Writes OUT/gradient.json
+/// implicit Euler substeps (damping, air drag and lagged friction included; docs/sensitivities.md). Writes OUT/gradient.json
 /// (the material's gradient in the material file's layout) and the run's frames and log. Exit code 0: done;
 /// 2: bad input (or settings the adjoint does not follow); 3: no gradient exists (the last step did not
 /// converge, or an equilibrium is not a strict minimum).

@@ -10,9 +10,21 @@
 //!
 //! where φ_f = μ_fᵀ H_f(q_f(x_k)) δq_f with its gradient and parameter derivatives from
 //! [`crate::shell::damping_lag`], and the drag's term comes from forward-mode AD of
-//! [`dissipation::drag_lagged_reference`] (the wind is no parameter). Damping with the 18×18 projection (option
-//! (a)) and a hinge beyond the fold barrier's threshold at a damped substep's start are not covered:
-//! [`ShellError::AdjointUnsupported`].
+//! [`dissipation::drag_lagged_reference`] (the wind is no parameter).
+//!
+//! Lagged friction ([`crate::shell::obstacle`]) freezes, for every free vertex v within an obstacle's layer at
+//! x_k, the normal n = ∇d(x_k) and the normal force λ = m k (δ_c − d(x_k))², and charges D_v = μ λ f₀(|T δ_v|)
+//! with δ_v = x_v − x_{k,v} − (o(t_{k+1}) − o(t_k)) (o the obstacle's placement). Its gradient is proportional to
+//! the masses (it joins the mass scale's ∂G/∂μ), its Hessian ∇²D_v joins H_k, and with a = ∇_n(μ_vᵀ∇D_v) and
+//! a_λ = ∂_λ(μ_vᵀ∇D_v) (forward-mode AD of [`crate::shell::obstacle::friction_lagged_reference`]) and
+//! ∇λ = −2 m k (δ_c − d) n,
+//!
+//!   x̄_{k,v} += ∇²D_v μ_v − (∇²d a + a_λ ∇λ),   dJ/dT_i += ∇²d a + a_λ ∇λ
+//!
+//! (an obstacle translated by T_i moves d(x − T_i), and o(t_{k+1}) − o(t_k) not at all). Which vertices are in
+//! contact is held as it ran; λ vanishes with its first derivative at the layer's edge, so a vertex entering
+//! the layer changes nothing to first order. Damping with the 18×18 projection (option (a)) and a hinge beyond
+//! the fold barrier's threshold at a damped substep's start are not covered: [`ShellError::AdjointUnsupported`].
 
 use super::{Exact, Sensitivity, Simulation};
 use crate::material::coefficients::{BasisEvaluator, Coefficient};
@@ -20,6 +32,7 @@ use crate::shell::assemble::{gather, zero_absent_flaps};
 use crate::shell::damping_lag::{DampingLag, DampingLagError};
 use crate::shell::dissipation::{self, DragFace};
 use crate::shell::element::ElementModel;
+use crate::shell::obstacle::{self, FrictionContact};
 use crate::shell::strain::NDOF;
 use crate::shell::{Psd, ShellError};
 use nalgebra::{Const, U1};
@@ -36,6 +49,22 @@ pub(super) struct Lag {
     drag: Vec<DragFace>,
     /// the substep's length h (s)
     h: f64,
+    /// the vertices in an obstacle's layer at x_k (empty without friction)
+    friction: Vec<Contact>,
+}
+
+/// A vertex in an obstacle's layer at a substep's start, with what lagged friction froze.
+struct Contact {
+    /// the frozen normal and normal force
+    fc: FrictionContact,
+    /// the obstacle
+    obstacle: usize,
+    /// its translation over the substep, o(t_{k+1}) − o(t_k)
+    moved: [f64; 3],
+    /// ∇²d at x_k (1/m)
+    hess_d: [[f64; 3]; 3],
+    /// ∇λ with respect to the vertex's position at x_k (N/m)
+    grad_lambda: [f64; 3],
 }
 
 impl Simulation {
@@ -54,10 +83,11 @@ impl Simulation {
         }
     }
 
-    /// The data substep k (length `h`) froze at its start `xk`; `None` without damping and wind.
-    pub(super) fn lag_at(&self, xk: &[f64], h: f64) -> Result<Option<Lag>, ShellError> {
+    /// The data substep k (length `h`, from `tk` to `tk + h`) froze at its start `xk`; `None` without damping,
+    /// wind and friction.
+    pub(super) fn lag_at(&self, xk: &[f64], h: f64, tk: f64) -> Result<Option<Lag>, ShellError> {
         let s = &self.settings;
-        if s.damping == 0.0 && s.wind.is_off() {
+        if s.damping == 0.0 && s.wind.is_off() && s.friction == 0.0 {
             return Ok(None);
         }
         let step = self.steps;
@@ -93,7 +123,56 @@ impl Simulation {
             hd,
             drag,
             h,
+            friction: self.contacts_at(xk, tk, tk + h),
         }))
+    }
+
+    /// The free vertices within an obstacle's layer at `xk` (time `tk`), as the forward step froze them for the
+    /// substep ending at `t1`.
+    fn contacts_at(&self, xk: &[f64], tk: f64, t1: f64) -> Vec<Contact> {
+        let s = &self.settings;
+        let mut out = vec![];
+        if s.friction == 0.0 {
+            return out;
+        }
+        for v in (0..self.pattern.n).filter(|&v| self.pattern.free[v].is_some()) {
+            let p = [xk[3 * v], xk[3 * v + 1], xk[3 * v + 2]];
+            for (i, motion) in self.obstacle_motions.iter().enumerate() {
+                let pr = self.obstacle_proximity(i, p, tk);
+                let pen = s.thickness - pr.d;
+                if pen <= 0.0 {
+                    continue;
+                }
+                let mk = self.mass[v] * s.contact_stiffness;
+                let (o0, o1) = (motion.position(tk), motion.position(t1));
+                out.push(Contact {
+                    fc: FrictionContact {
+                        vertex: v,
+                        n: pr.n,
+                        lambda: mk * pen * pen,
+                    },
+                    obstacle: i,
+                    moved: std::array::from_fn(|c| o1[c] - o0[c]),
+                    hess_d: pr.hess,
+                    grad_lambda: pr.n.map(|nc| -2.0 * mk * pen * nc),
+                });
+            }
+        }
+        out
+    }
+
+    /// One contact's δ, friction gradient and Hessian at the current state.
+    fn contact_terms(
+        &self,
+        c: &Contact,
+        xk: &[f64],
+        h: f64,
+    ) -> ([f64; 3], [f64; 3], [[f64; 3]; 3]) {
+        let s = &self.settings;
+        let v = c.fc.vertex;
+        let delta = std::array::from_fn(|a| self.x[3 * v + a] - xk[3 * v + a] - c.moved[a]);
+        let (_, g, hb) = obstacle::friction(&c.fc, s.friction, s.friction_velocity * h, delta);
+        (delta, g, hb)
     }
 
     /// Add the lagged terms' gradients (all dofs) and Hessians (free dofs) at the current state x_{k+1} to `ex`.
@@ -129,10 +208,21 @@ impl Simulation {
         for (a, b) in ex.g_full.iter_mut().zip(&g) {
             *a += b;
         }
+        for c in &lag.friction {
+            let v = c.fc.vertex;
+            let (_, g, hb) = self.contact_terms(c, xk, lag.h);
+            for a in 0..3 {
+                ex.g_full[3 * v + a] += g[a];
+                ex.g_mass[3 * v + a] += g[a];
+            }
+            if let Some(f) = self.pattern.free[v] {
+                self.pattern.add_diag_block(&mut ex.values, f, &hb);
+            }
+        }
     }
 
-    /// (κ Σ_f H_f + Σ_f ∇²_xΠ_f) w over all dofs, at the current state.
-    pub(super) fn lag_times(&self, lag: &Lag, w: &[f64]) -> Vec<f64> {
+    /// (κ Σ_f H_f + Σ_f ∇²_xΠ_f + Σ_v ∇²D_v) w over all dofs, at the current state (`xk` the substep's start).
+    pub(super) fn lag_times(&self, lag: &Lag, xk: &[f64], w: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; w.len()];
         for (si, hm) in lag.hd.iter().enumerate() {
             let st = &self.stencils[si];
@@ -153,6 +243,13 @@ impl Simulation {
                 hw[r] = (0..9).map(|j| h9[r][j] * wl[j]).sum();
             }
             scatter(st, &hw, &mut out);
+        }
+        for c in &lag.friction {
+            let v = c.fc.vertex;
+            let (_, _, hb) = self.contact_terms(c, xk, lag.h);
+            for a in 0..3 {
+                out[3 * v + a] += (0..3).map(|b| hb[a][b] * w[3 * v + b]).sum::<f64>();
+            }
         }
         out
     }
@@ -194,7 +291,45 @@ impl Simulation {
             }
             scatter(st, &gs, xbar);
         }
+        for c in &lag.friction {
+            self.contact_adjoint(c, lag.h, xk, mu, out, xbar);
+        }
         Ok(())
+    }
+
+    /// One friction contact's share of x̄_k and of dJ/dT_i (module documentation).
+    fn contact_adjoint(
+        &self,
+        c: &Contact,
+        h: f64,
+        xk: &[f64],
+        mu: &[f64],
+        out: &mut Sensitivity,
+        xbar: &mut [f64],
+    ) {
+        type D4 = DualSVec64<4>;
+        let s = &self.settings;
+        let v = c.fc.vertex;
+        let (delta, _, hb) = self.contact_terms(c, xk, h);
+        let mv = [mu[3 * v], mu[3 * v + 1], mu[3 * v + 2]];
+        let d: Vec<Dual<D4>> = (0..3)
+            .map(|a| Dual::new(D4::from_re(delta[a]), D4::from_re(mv[a])))
+            .collect();
+        let n: Vec<Dual<D4>> = (0..3)
+            .map(|a| Dual::new(D4::from_re(c.fc.n[a]).derivative(a), D4::from_re(0.0)))
+            .collect();
+        let lambda = Dual::new(D4::from_re(c.fc.lambda).derivative(3), D4::from_re(0.0));
+        let eps = s.friction_velocity * h;
+        let f = obstacle::friction_lagged_reference(&n, lambda, s.friction, eps, &d);
+        let g = f.eps.eps.unwrap_generic(Const::<4>, U1);
+        // ∇²d a + a_λ ∇λ: μᵀ ∂∇D/∂x_k through the frozen n and λ
+        let through: [f64; 3] = std::array::from_fn(|a| {
+            (0..3).map(|b| c.hess_d[a][b] * g[b]).sum::<f64>() + g[3] * c.grad_lambda[a]
+        });
+        for a in 0..3 {
+            xbar[3 * v + a] += (0..3).map(|b| hb[a][b] * mv[b]).sum::<f64>() - through[a];
+            out.obstacles[c.obstacle][a] += through[a];
+        }
     }
 
     fn damping_adjoint(

@@ -25,8 +25,8 @@
 //!
 //! Supported: implicit Euler (fixed or adaptive substeps: the recorded ones), elastic energy, gravity, linear
 //! drag, obstacle penalties, hard constraints, handle springs, and stiffness-proportional damping and air drag,
-//! whose data lagged at x_k add their own terms (`lag`). Not: friction, BDF2 and the linearised scheme, damping
-//! with the 18×18 projection: [`ShellError::AdjointUnsupported`].
+//! and lagged friction, whose data lagged at x_k add their own terms (`lag`). Not: BDF2 and the linearised
+//! scheme, damping with the 18×18 projection: [`ShellError::AdjointUnsupported`].
 
 use super::{Exact, HeldGradient, Observable, Sensitivity, Simulation};
 use crate::material::coefficients::MaterialGradient;
@@ -98,8 +98,6 @@ impl Simulation {
             "the simulation is quasi-static (use the static sensitivity)"
         } else if s.integrator != Integrator::ImplicitEuler {
             "the trajectory adjoint follows implicit Euler substeps only"
-        } else if s.friction > 0.0 {
-            "friction lags the previous step's contacts"
         } else if self.tape.as_ref().is_none_or(|t| t.steps.is_empty()) {
             "no substep was recorded (start_tape before stepping)"
         } else {
@@ -202,7 +200,12 @@ impl Simulation {
             self.time = st.time;
             let mut ex = self.exact_system()?;
             let inertia = self.add_inertia(tape, k, &mut ex);
-            let lag = self.lag_at(xk, h)?;
+            let tk = if k == 0 {
+                tape.t0
+            } else {
+                tape.steps[k - 1].time
+            };
+            let lag = self.lag_at(xk, h, tk)?;
             if let Some(lag) = &lag {
                 self.add_lag_terms(lag, xk, &mut ex);
             }
@@ -212,7 +215,7 @@ impl Simulation {
                 let (value, mut djdx, uo) = self.observable_parts(obs, &ex)?;
                 if let (Some(lag), true) = (&lag, uo.iter().any(|&a| a != 0.0)) {
                     // a reaction's ∂R/∂x_f gains the lagged terms' free–held coupling
-                    let hu = self.lag_times(lag, &uo);
+                    let hu = self.lag_times(lag, xk, &uo);
                     for v in (0..n).filter(|&v| self.pattern.free[v].is_some()) {
                         for c in 0..3 {
                             djdx[3 * v + c] += hu[3 * v + c];
@@ -251,7 +254,7 @@ impl Simulation {
             }
             self.add_parameter_terms(&mu, &ex.g_mass, energy && observed, &mut out)?;
             let seen = observed.then_some(obs);
-            let lag_mu = lag.as_ref().map(|l| self.lag_times(l, &mu));
+            let lag_mu = lag.as_ref().map(|l| self.lag_times(l, xk, &mu));
             accumulate_held(
                 &mut out.held,
                 self.held_gradients(seen, &mu, &a, inertia, lag_mu.as_deref())?,
