@@ -142,9 +142,11 @@ impl ElementModel {
     fn contracted_third(&self, z: &[f64; 6], m: &[[f64; 6]; 6]) -> [f64; 7] {
         let eig = SymmetricEigen::new(SMatrix::<f64, 6, 6>::from_fn(|i, j| m[i][j]));
         let mut out = [0.0; 7];
+        // M is often of rank 2 (sym(J a (J b)ᵀ) where P is the identity): its other eigenvalues are rounding
+        let floor = 1e-14 * eig.eigenvalues.iter().fold(0.0f64, |m, l| m.max(l.abs()));
         for e in 0..6 {
             let me = eig.eigenvalues[e];
-            if me == 0.0 {
+            if me.abs() <= floor {
                 continue;
             }
             let v = eig.eigenvectors.column(e);
