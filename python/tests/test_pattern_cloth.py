@@ -194,6 +194,10 @@ def test_gradient_equals_its_file_and_the_vjp_equals_a_target(tmp_path):
         hylc.gradient(scene, cotangent=np.zeros((3, 3)))
     damped = json.loads(open(scene).read())
     damped.update(quasi_static=False, damping=0.01, dt=1 / 60, duration=1 / 60)
+    # damping under option (b) is followed; under the 18×18 projection it is refused
+    (tmp_path / "damped_psi.json").write_text(json.dumps(damped))
+    assert np.isfinite(hylc.gradient(str(tmp_path / "damped_psi.json"), observable="energy")["value"])
+    damped["psd"] = "full"
     (tmp_path / "damped.json").write_text(json.dumps(damped))
     with pytest.raises(ValueError, match="damping"):
         hylc.gradient(str(tmp_path / "damped.json"), observable="energy")
