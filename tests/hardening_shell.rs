@@ -439,3 +439,79 @@ fn duration_zero_warns_once() {
     assert!(out.join("frame_0000.obj").exists());
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// `hylc simulate SCENE --quiet --out (scratch folder)` with extra arguments: its stderr lines that start with
+/// `warning:` and contain `needle`.
+fn simulate_warnings(name: &str, args: &[&str], needle: &str) -> Vec<String> {
+    let out = std::env::temp_dir().join(format!("hylc-warn-{name}-{}", std::process::id()));
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_hylc"))
+        .arg("simulate")
+        .args(args)
+        .args(["--quiet", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).to_string();
+    assert!(o.status.success(), "{err}");
+    let _ = std::fs::remove_dir_all(&out);
+    err.lines()
+        .filter(|l| l.starts_with("warning:") && l.contains(needle))
+        .map(str::to_string)
+        .collect()
+}
+
+/// Strains outside the material's knots: one warning after the run naming the component, its visited range
+/// against the knots and the steps outside, with `hylc scene-plan` on the run's log; silent when the run stays
+/// inside, and silent on the bending components when bending is off.
+#[test]
+fn strains_outside_the_knots_warn_once() {
+    // the default material with s_x's knots squeezed to about ±1e-3: any stretch leaves them
+    let mut m = default_material();
+    m.strain_scale[0] = 1e-3;
+    let narrow = temp_file("narrow.material.json", &m.to_json_string());
+    let base = [
+        "stretch-x",
+        "--duration",
+        "0.05",
+        "--edge",
+        "0.02",
+        "--no-bending",
+    ];
+    let mut args = base.to_vec();
+    args.extend(["--material", narrow.to_str().unwrap()]);
+    let w = simulate_warnings("narrow", &args, "knots");
+    assert_eq!(w.len(), 1, "{w:?}");
+    let w = &w[0];
+    assert!(
+        w.starts_with("warning: strains outside the material's fitted knots, where ψ extrapolates: s_x visited [")
+            && w.contains("knots [-6.000e-4, 9.000e-4]")
+            && w.contains("in 3 of 3 steps")
+            && w.contains("hylc scene-plan ")
+            && w.contains("log.jsonl"),
+        "{w}"
+    );
+    assert!(!w.contains("II00") && !w.contains("II11"), "{w}");
+    // the default material's knots hold this short stretch
+    assert!(simulate_warnings("inside", &base, "knots").is_empty());
+}
+
+/// A mesh edge longer than a quarter of the cloth's bounding-box diagonal: one warning before the run; a finer
+/// mesh is silent.
+#[test]
+fn a_mesh_too_coarse_to_bend_warns_once() {
+    let w = simulate_warnings(
+        "coarse",
+        &["drape-x", "--duration", "0", "--edge", "0.1"],
+        "too coarse",
+    );
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("warning: the longest mesh edge, ")
+            && w[0]
+                .contains("quarter of the cloth's bounding-box diagonal (0.4243 m / 4 = 0.1061 m)"),
+        "{}",
+        w[0]
+    );
+    let fine = ["drape-x", "--duration", "0", "--edge", "0.05"];
+    assert!(simulate_warnings("fine", &fine, "too coarse").is_empty());
+}

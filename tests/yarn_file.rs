@@ -163,3 +163,46 @@ fn sample_sidecars_record_the_yarn_and_old_sidecars_read() {
         .to_string();
     assert!(e.contains("`young`") && e.contains("s.meta.json"), "{e}");
 }
+
+/// A yarn file whose radius differs from the pattern's: one warning naming both, the pattern's used; a file with
+/// the pattern's radius is silent.
+#[test]
+fn a_yarn_radius_the_pattern_overrides_warns_once() {
+    let d = dir();
+    let warnings = |yarn: &YarnMaterial, name: &str| -> Vec<String> {
+        let f = d.join(name);
+        yarn.save_json(&f).unwrap();
+        let out = hylc(&[
+            "solve",
+            "plain",
+            "--z",
+            "0,0,0",
+            "--yarn",
+            f.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{out:?}");
+        String::from_utf8_lossy(&out.stderr)
+            .lines()
+            .filter(|l| l.contains("radius"))
+            .map(str::to_string)
+            .collect()
+    };
+    let thick = YarnMaterial {
+        radius: 2e-3,
+        ..Default::default()
+    };
+    let w = warnings(&thick, "thick.json");
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("warning: ")
+            && w[0].contains("thick.json: radius 0.002 m is not used: the pattern plain carries its own radius, 0.001 m"),
+        "{}",
+        w[0]
+    );
+    // the generated pattern's radius (1 mm) within 1e-6 relative: silent
+    let same = YarnMaterial {
+        radius: 1e-3 * (1.0 + 1e-9),
+        ..Default::default()
+    };
+    assert!(warnings(&same, "same.json").is_empty());
+}

@@ -174,7 +174,7 @@ fn solve(
     if !scene.quasi_static {
         sim.start_tape();
     }
-    let summary = run_reporting(&mut sim, &tris, steps, &scene.output, out, on_event)?;
+    let summary = run_reporting(&mut sim, &tris, steps, &scene.output, out, None, on_event)?;
     match summary.last {
         Some(r) if !r.converged => Err(WorkflowError::NoGradient(format!(
             "{scene_arg}: the step at t = {:.4} s did not converge (residual {:.2e} N): no gradient of an \

@@ -7,6 +7,8 @@
 //! - [`fit`]: Algorithm C5 on a sample file, with the material, the JSON report and the plots written;
 //! - [`simulate`]: a cloth scene (C8) with overrides, its frames, log and PNG snapshot;
 //! - [`gradient`]: dJ/dp of an observable of a quasi-static scene by one adjoint solve, with an optional check;
+//! - [`warnings`]: warnings that an input is suspect (strains outside a material's knots, a mesh too coarse to
+//!   bend, a yarn radius the pattern replaces);
 //! - [`pipeline`]: the main job `hylc run` (C1 → C4 → C5–C7 → C8) end to end.
 //!
 //! Nothing here prints: what a terminal would show goes to an [`Event`] callback (`Send`, because sampling reports
@@ -32,6 +34,7 @@ pub mod inputs;
 pub mod pipeline;
 pub mod sidecar;
 pub mod simulate;
+pub mod warnings;
 pub mod yarn_chain;
 
 use std::path::{Path, PathBuf};

@@ -1,6 +1,7 @@
 //! A cloth scene (Algorithm C8; `docs/cloth-simulator.md`, `crate::shell::scene`) with command-line style overrides: its
 //! frames (`frame_NNNN.obj`), its step log (`log.jsonl`) and a PNG snapshot of the final state.
 
+use super::warnings::{coarse_mesh, StrainVisits};
 use super::{Event, WorkflowError};
 use crate::shell::render::{write_png, Layer, View};
 use crate::shell::scene::{run_with, MeshSpec, RunSummary, Scene};
@@ -172,7 +173,9 @@ pub struct Outcome {
 }
 
 /// Build and run a scene, writing the frames and the log to `out`; reports the scene as an [`Event::Print`]
-/// line and every step as an [`Event::Step`].
+/// line and every step as an [`Event::Step`], and as [`Event::Note`]s a mesh too coarse to bend before the run
+/// ([`super::warnings::coarse_mesh`]) and strains outside the material's knots after it
+/// ([`super::warnings::StrainVisits`]).
 pub fn execute(
     scene: &Scene,
     scene_arg: &str,
@@ -182,6 +185,9 @@ pub fn execute(
 ) -> Result<Outcome, WorkflowError> {
     let (mut sim, tris) = scene.build(scene_arg, dir)?;
     let steps = scene.steps();
+    if let Some(w) = coarse_mesh(&sim.positions(), &tris) {
+        on_event(Event::Note(&w.to_string()));
+    }
     on_event(Event::Print(&format!(
         "scene {scene_arg}: {} triangles, {} vertices, {} free dofs, {} steps of {:.4} s{}; output in {}",
         tris.len(),
@@ -192,7 +198,19 @@ pub fn execute(
         if scene.quasi_static { " (quasi-static)" } else { "" },
         out.display()
     )));
-    let summary = run_reporting(&mut sim, &tris, steps, &scene.output, Some(out), on_event)?;
+    let mut visits = StrainVisits::new(&sim.model);
+    let summary = run_reporting(
+        &mut sim,
+        &tris,
+        steps,
+        &scene.output,
+        Some(out),
+        Some(&mut visits),
+        on_event,
+    )?;
+    if let Some(w) = visits.warning(Some(&out.join("log.jsonl"))) {
+        on_event(Event::Note(&w.to_string()));
+    }
     Ok(Outcome {
         summary,
         positions: sim.positions(),
@@ -201,18 +219,22 @@ pub fn execute(
     })
 }
 
-/// [`run_with`] reporting every step as an [`Event::Step`].
+/// [`run_with`] reporting every step as an [`Event::Step`], and adding it to `visits` when given.
 pub(crate) fn run_reporting(
     sim: &mut crate::shell::solver::Simulation,
     tris: &[[usize; 3]],
     steps: usize,
     output: &crate::shell::scene::OutputSpec,
     out: Option<&Path>,
+    mut visits: Option<&mut StrainVisits>,
     on_event: &mut (dyn FnMut(Event) + Send),
 ) -> Result<RunSummary, ShellError> {
     let mut done = 0;
     run_with(sim, tris, steps, output, out, |r| {
         done += 1;
+        if let Some(v) = visits.as_deref_mut() {
+            v.add(r);
+        }
         on_event(Event::Step {
             done,
             total: steps,

@@ -4,6 +4,7 @@ use clap::ValueEnum;
 use hylc::micro::reference::Construction;
 use hylc::micro::{CrossingGuard, Predictor, SolverOptions, StepRule};
 use hylc::rod::YarnMaterial;
+use hylc::workflow::warnings::radius_overridden;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -102,6 +103,15 @@ pub struct YarnArgs {
 }
 
 impl YarnArgs {
+    /// A warning on stderr when the yarn file's radius differs from the radius of the pattern `pattern` (the
+    /// argument that named it), which every solve takes instead (`hylc::workflow::warnings::radius_overridden`).
+    pub fn warn_radius(&self, yarn: &YarnMaterial, pattern: &str, pattern_radius: f64) {
+        let Some(file) = &self.yarn else { return };
+        if let Some(w) = radius_overridden(file, yarn.radius, pattern, pattern_radius) {
+            eprintln!("{w}");
+        }
+    }
+
     /// The yarn file's parameters, or the defaults without `--yarn`.
     pub fn material(&self) -> anyhow::Result<YarnMaterial> {
         match &self.yarn {

@@ -33,6 +33,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let (pattern, equilibrate_only, out) = (a.pattern.as_str(), a.equilibrate_only, &a.out);
     let yarn = a.yarn.material()?;
     let p = load_pattern_noted(pattern)?;
+    a.yarn.warn_radius(&yarn, pattern, p.radius);
     let (q, report, construction) = reference_of(
         pattern,
         &p,

@@ -3,6 +3,7 @@
 
 use crate::args::{ConstructionArg, PresetArg, YarnArgs};
 use crate::printer::Printer;
+use hylc::workflow::inputs::load_pattern;
 use hylc::workflow::pipeline::{self, RunConfig};
 use hylc::workflow::simulate::diverged;
 use std::path::PathBuf;
@@ -52,6 +53,13 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
+    let yarn = a.yarn.material()?;
+    for arg in &a.pattern {
+        // a pattern that does not load is the pipeline's error, reported there
+        if let Ok(loaded) = load_pattern(arg) {
+            a.yarn.warn_radius(&yarn, arg, loaded.pattern.radius);
+        }
+    }
     let config = RunConfig {
         out: a.out,
         patterns: a.pattern,
@@ -62,7 +70,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
         dt: a.dt,
         fresh: a.fresh,
         construction: a.construction.map(Into::into),
-        yarn: a.yarn.material()?,
+        yarn,
         fit: hylc::fit::FitPreset::from(a.preset).options(),
     };
     let mut printer = Printer::default();

@@ -85,6 +85,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let shard = a.shard.as_deref().map(parse_shard).transpose()?;
     let yarn = a.yarn.material()?;
     let p = load_pattern_noted(pattern)?;
+    a.yarn.warn_radius(&yarn, pattern, p.radius);
     let mut options = a.solver.options();
     let starts = Starts::from(a.starts);
     if starts != Starts::Warm && a.solver.crossings.is_none() {

@@ -28,6 +28,7 @@ pub struct Args {
 pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let yarn = a.yarn.material()?;
     let p = load_pattern_noted(&a.pattern)?;
+    a.yarn.warn_radius(&yarn, &a.pattern, p.radius);
     let problem = MicroProblem::new(p, &yarn, SolverOptions::default());
     let strain = parse_strain(&a.z)?;
     let sol = problem.solve(&strain, None)?;

@@ -75,6 +75,7 @@ pub fn run(a: Args) -> anyhow::Result<ExitCode> {
     let (cold, json_out) = (a.cold, a.json);
     let p = load_pattern_noted(&a.pattern)?;
     let mut yarn = a.yarn.material()?;
+    a.yarn.warn_radius(&yarn, &a.pattern, p.radius);
     if let Some(q) = a.quadrature {
         if q == 0 {
             anyhow::bail!("--quadrature: expected at least 1 point per segment");
