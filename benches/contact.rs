@@ -1,4 +1,4 @@
-//! Contact kernels and broad phase (`06-verification.md`, section 4).
+//! Contact kernels and broad phase (timings in `docs/results.md`, "Yarn model kernels").
 //!
 //! Pair kernel: a touching crossing pair (perpendicular segments of 2r, normalised gap ρ = 0.9, so the central
 //! quadrature pairs are inside the cut-off and the outer ones beyond), value alone and value + gradient + Hessian

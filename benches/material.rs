@@ -1,10 +1,10 @@
-//! ψ + ∇ψ + ∇²ψ per evaluation (issue 20 target: ≤ 0.5 µs for basket1 on an idle machine; the original takes
+//! ψ + ∇ψ + ∇²ψ per evaluation (target: ≤ 0.5 µs for basket1 on an idle machine; the original takes
 //! about 3.7 µs on this machine kind), for the original basket1 and stock1 and the embedded default material.
 //! Baselines measured in the same run: the value alone, and the same derivatives by num-dual automatic
 //! differentiation of the generic reference implementation. Time per iteration covers 64 strains.
 //!
-//! `HYLC_BENCH_MATERIALS=name=path,name=path` adds material files (e.g. a base fit and its extended variants, issue
-//! 19's candidate table, whose cost ratios are taken within one run).
+//! `HYLC_BENCH_MATERIALS=name=path,name=path` adds material files (e.g. a base fit and its extended variants, the
+//! candidates of `validation/fit_candidates.py`, whose cost ratios are taken within one run; `docs/fitting.md`).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use hylc::checks::material::PsiCheck;

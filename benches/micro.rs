@@ -1,4 +1,4 @@
-//! The micro solver (`06-verification.md`, section 4; issue 4): one Newton iteration (tile energy + gradient +
+//! The micro solver (`docs/micro-solver.md`): one Newton iteration (tile energy + gradient +
 //! Hessian, and the KKT solve) and complete solves, cold from the reference state and warm-started from a
 //! neighbouring strain (0.006 away in s_x and s_y, the spacing of a default 150-sample range), for the generated
 //! plain weave and stockinette and, when ../shared is present, each original pattern (at its implied periods when

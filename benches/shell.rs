@@ -1,5 +1,5 @@
-//! Macro-scale kernels (issue 6 targets: per-triangle force + Hessian ≤ 4.7 µs, ≤ 7 µs with PSD projection; time
-//! per Newton iteration growing near-linearly with the mesh size).
+//! Macro-scale kernels (targets: per-triangle force + Hessian ≤ 4.7 µs, ≤ 7 µs with PSD projection; time per
+//! Newton iteration growing near-linearly with the mesh size; timings in `docs/results.md`, "Cloth simulation").
 //!
 //! - `triangle[<material>]/<psd>`: value, gradient and Hessian of one triangle energy (strain chain + ψ + chain
 //!   rule + projection), averaged over 64 random stencils of the derivative harness's sampler;

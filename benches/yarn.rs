@@ -1,4 +1,4 @@
-//! Rod kernels and the whole-tile energy (`06-verification.md`, section 4; issue 3).
+//! Rod kernels and the whole-tile energy (timings in `docs/results.md`, "Yarn model kernels").
 //!
 //! Kernels: stretching value + gradient + Hessian; bending+twisting value alone and value + gradient + exact
 //! Hessian at a generic stencil evaluated away from its stored state (transport active), with num-dual AD of the

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Parameter sensitivity of the generated stockinette along s_x (issue 21, item 3).
+"""Parameter sensitivity of the generated stockinette along s_x (`docs/python.md`, "Example: sensitivity study").
 
 Ψ̄(s_x) of the generated pattern (as `hylc solve stockinette` uses it, not its C1 reference state) and its
 sensitivities to the yarns' bending factor γ and contact stiffness k_c, from the envelope theorem

@@ -1,5 +1,5 @@
-//! Property tests of the contact pair energy (`06-verification.md`, section 2: "contact: symmetric in the pair;
-//! zero beyond 2r; monotone in distance"), plus invariance under reversing a segment and under rigid motions.
+//! Property tests of the contact pair energy (`docs/yarn-model.md`): symmetric in the pair, zero beyond 2r,
+//! monotone in distance, plus invariance under reversing a segment and under rigid motions.
 //!
 //! Inputs come from the harness sampler [`sample_pair`] (all its categories: generic, nearly parallel, at the
 //! cut-off, deep, short, long, partly beyond, beyond) driven by a proptest seed, and from explicit crossing

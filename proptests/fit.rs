@@ -1,4 +1,4 @@
-//! Property tests of the 1D fitting (issue 5; `04-sampling-fitting.md`, "Fitting (C5, C6, C7)", FIT1D): random
+//! Property tests of the 1D fitting (FIT1D; `docs/fitting.md`, "Tests"): random
 //! noisy samples of random quasi-convex ground truths, fitted with FIT1D, give splines that are quasi-convex and
 //! monotone on each side of their minimum on a dense grid reaching 50 % beyond the knots, with slopes that respect
 //! pˣ_min; MLS reproduces quadratics; symlog∘symexp = identity; noise-free samples of a smooth convex function are

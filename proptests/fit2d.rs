@@ -1,4 +1,4 @@
-//! Property tests of FIT2D (issue 5; `04-sampling-fitting.md`, "Fitting (C5, C6, C7)", FIT2D): random noisy grid
+//! Property tests of FIT2D (`docs/fitting.md`, "Tests"): random noisy grid
 //! samples of random quasi-convex ground truths give a fitted surface f that is quasi-convex (monotone on each side
 //! of its minimum) along every knot row and column, on a dense grid reaching 50 % beyond the knots, and monotone
 //! inside the patches away from the minimum's row and column, with knot slopes that respect pˣ_min; the residual

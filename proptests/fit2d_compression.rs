@@ -1,5 +1,5 @@
-//! Property tests of FIT2D step 7′ (`hylc fit --compression-residual`; `04-sampling-fitting.md`, "Fitting (C5,
-//! C6, C7)", FIT2D step 7 and its variant 7′): on random noisy samples (with rare branch outliers up to 10× the
+//! Property tests of FIT2D step 7′ (`hylc fit --compression-residual`; `docs/fitting.md`, "Options beyond the
+//! default fit", FIT2D step 7 and its variant 7′): on random noisy samples (with rare branch outliers up to 10× the
 //! truth) of quasi-convex truths that couple compression with the other strain, the kept compressed residual is
 //! ≥ 0 and monotone outward from the axes on dense lines reaching 50 % beyond the knots, equals the default
 //! residual on the tension side, is C¹ across every knot line, and never lies below the default residual (so

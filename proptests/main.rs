@@ -1,6 +1,6 @@
-//! Property tests (`06-verification.md`, section 2). Rods (`rod.rs`), contact (`contact.rs`) and the micro solver
+//! Property tests. Rods (`rod.rs`), contact (`contact.rs`) and the micro solver
 //! (`micro.rs`) have their own
-//! modules; this file holds those of the spline material (issue 2): Hermite interpolation at
+//! modules; this file holds those of the spline material (`docs/material.md`): Hermite interpolation at
 //! knots, C¹ continuity across knots and at the extrapolation boundary, invariance of the bending terms under the
 //! order of the eigenpairs, ψ as the sum of its parts, finite values and derivatives at umbilic points and for
 //! |II| up to 1e4.

@@ -1,4 +1,4 @@
-//! Property tests of the micro scale (`06-verification.md`, section 2, "elimination" and "micro"):
+//! Property tests of the micro scale, the elimination map and the micro solver (`docs/micro-solver.md`):
 //! - every copy produced by the elimination map equals the surface point of the shifted reference coordinates
 //!   (i.e. the tile transform of the original vertex), for random admissible strains and displacements;
 //! - zero strain and ũ = 0 reproduce the reference positions, and the reference state of Algorithm C1 is an

@@ -1,4 +1,4 @@
-//! Property tests of the rod stencils (`06-verification.md`, section 2): invariance under rigid motions and under
+//! Property tests of the rod stencils (`docs/yarn-model.md`): invariance under rigid motions and under
 //! a rotation of the reference frames compensated by θ, gradients that sum to zero over a translation, and a
 //! reference twist that stays continuous along a path crossing ±π.
 

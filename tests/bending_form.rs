@@ -1,6 +1,6 @@
-//! The bending-discretisation variant of issue 22 (`"bending": "sin"` in a yarn file): rest curvatures stored in
-//! the `tan` form carry over exactly (a stress-free rest shape stays stress-free), and the form changes the
-//! response of a bent state.
+//! The bending-discretisation variant (`"bending": "sin"` in a yarn file; `docs/yarn-parameters.md`, "Bending
+//! discretisation"): rest curvatures stored in the `tan` form carry over exactly (a stress-free rest shape stays
+//! stress-free), and the form changes the response of a bent state.
 
 use hylc::generate::{stockinette, weave, KnitParams, WeaveParams};
 use hylc::pattern::Pattern;

@@ -1,6 +1,7 @@
 //! Conformance of ψ, ∇ψ, ∇²ψ with the original implementation on its five materials
-//! (`../shared/oracles/psi_oracle.json`; `06-verification.md`, 3a; `hylc::validation::conformance::psi_conformance`). Relative
-//! normwise tolerances of issue 2: 1e-10 for ψ and ∇ψ, 1e-8 for ∇²ψ. The oracle README warns of ~1e-6 round-off
+//! (`../shared/oracles/psi_oracle.json`; validation item a of `docs/results.md`, "Validation against the original
+//! (`hylc validate`)"; `hylc::validation::conformance::psi_conformance`). Relative normwise tolerances: 1e-10 for
+//! ψ and ∇ψ, 1e-8 for ∇²ψ. The oracle README warns of ~1e-6 round-off
 //! in one Hessian entry of the original near equal principal curvatures; normwise, every sample (those included)
 //! is held to 1e-8.
 

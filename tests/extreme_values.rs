@@ -1,6 +1,7 @@
-//! Extreme-value properties (issue 17): 10⁴ random extreme inputs each for ψ, the shell strain chain, the rod
-//! stencils (their checked entry points) and the contact pair kernel give finite outputs or an explicit rejection (a typed error, or `None` for a degenerate
-//! triangle) — never NaN or inf. Inputs mix magnitudes from 1e-300 to 1e300 of either sign with zeros, NaN and ±inf.
+//! Extreme-value properties (`docs/robustness.md`): 10⁴ random extreme inputs each for ψ, the shell strain chain, the
+//! rod stencils (their checked entry points) and the contact pair kernel give finite outputs or an explicit rejection
+//! (a typed error, or `None` for a degenerate triangle) — never NaN or inf. Inputs mix magnitudes from 1e-300 to 1e300
+//! of either sign with zeros, NaN and ±inf.
 
 use hylc::contact::pair::PairKernel;
 use hylc::material::synthetic::default_material;

@@ -1,4 +1,4 @@
-//! `hylc fit` end to end on synthetic samples (issue 5; `04-sampling-fitting.md`, "Fitting (C5, C6, C7)"): sample
+//! `hylc fit` end to end on synthetic samples (`docs/fitting.md`): sample
 //! files whose Ψ̄ is a known material's ψ, so the fit must give back that material: per-term and held-out errors,
 //! failed samples excluded and counted, the exported JSON (original format + meta) loading again, plots written,
 //! and bad input reported in one line.
@@ -161,7 +161,7 @@ fn fit_recovers_a_known_material_from_its_samples() {
     std::fs::remove_dir_all(&d).ok();
 }
 
-/// `hylc fit --compression-residual` (FIT2D step 7′, issue 19) on samples of the default material plus a coupling
+/// `hylc fit --compression-residual` (FIT2D step 7′) on samples of the default material plus a coupling
 /// of compression with shear, c (max(−s_x, 0)² + max(−s_y, 0)²) s_a² (as large at (−0.5, 0.7) as ψ at s_x = 0.9),
 /// that the zero-compression residual cannot
 /// represent: the planes with shear are fitted better than by the default fit, the two materials agree where no
@@ -291,7 +291,7 @@ fn fit_bad_input_is_one_line() {
 /// `hylc run`'s fit settings (`FitOptions::covering`: knots over the whole sampled range, the compressed
 /// half-plane's residual kept, an MLS bandwidth of one median spacing) fit a steep compressed-and-bent corner that
 /// a coarse plan (6 samples per 2D axis, as `hylc run`'s quick plan) samples only at its edge with at most 0.2 of
-/// the error of the design's settings (knots on 0.9 of the range, zero residual in compression, bandwidth two
+/// the error of the method's settings (knots on 0.9 of the range, zero residual in compression, bandwidth two
 /// spacings; measured 0.086 against 0.86, and 0.45 with covering's knots at bandwidth 2).
 #[test]
 fn covering_knots_fit_the_corner_of_a_coarse_plan_better() {

@@ -1,7 +1,7 @@
-//! The fuzz suite in CI (issue 17; `hylc::validation::fuzz`): mutated `.pyp` patterns, material JSON, sampling
-//! plans, scene JSON and sample files through the library's parsers and evaluators. Every case must end in an
-//! accepted input with finite outputs or a typed error: no panic, no non-finite number, no case over its time
-//! budget. `HYLC_FUZZ_CASES` sets the cases per format (default 600); `validation/fuzz.sh` runs 10⁶.
+//! The fuzz suite in CI (`docs/robustness.md`, "The fuzz suite"; `hylc::validation::fuzz`): mutated `.pyp` patterns,
+//! material JSON, sampling plans, scene JSON and sample files through the library's parsers and evaluators. Every case
+//! must end in an accepted input with finite outputs or a typed error: no panic, no non-finite number, no case over its
+//! time budget. `HYLC_FUZZ_CASES` sets the cases per format (default 600); `validation/fuzz.sh` runs 10⁶.
 
 use hylc::validation::fuzz::{run, Format, FuzzReport};
 

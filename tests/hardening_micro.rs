@@ -1,6 +1,6 @@
-//! Issue 17 (hardening) for the micro solver, patterns and materials: absurd strains, pattern values and material
-//! coefficients are rejected up front with the component, block/line or JSON path named; the start phase honours
-//! the time limit; a non-finite Ψ̄ is an error, never "converged".
+//! Hardening (`docs/robustness.md`) of the micro solver, patterns and materials: absurd strains, pattern values and
+//! material coefficients are rejected up front with the component, block/line or JSON path named; the start phase
+//! honours the time limit; a non-finite Ψ̄ is an error, never "converged".
 
 mod common;
 

@@ -1,6 +1,6 @@
-//! Issue 17 for plans, sample files and the fit: huge counts and inadmissible ranges rejected in one line (exit
-//! 2), a UTF-8 byte-order mark accepted, only `Converged` records fitted, duplicated ids with different results
-//! and absurd values rejected, and the exit codes (0 complete, 2 bad input, 3 did not converge) of `sample` and
+//! Hardening (`docs/robustness.md`) of plans, sample files and the fit: huge counts and inadmissible ranges rejected in
+//! one line (exit 2), a UTF-8 byte-order mark accepted, only `Converged` records fitted, duplicated ids with different
+//! results and absurd values rejected, and the exit codes (0 complete, 2 bad input, 3 did not converge) of `sample` and
 //! `fit`.
 
 mod common;

@@ -1,6 +1,6 @@
-//! Issue 17, the cloth scenes: sizes against documented limits before any allocation, physical parameters in
-//! range with the field named, vertex selections checked, a byte-order mark accepted, a diverging run stopped
-//! with an error, and `hylc simulate`'s exit codes (0 complete, 2 bad input, 3 did not converge).
+//! Hardening (`docs/robustness.md`) of the cloth scenes: sizes against documented limits before any allocation,
+//! physical parameters in range with the field named, vertex selections checked, a byte-order mark accepted, a
+//! diverging run stopped with an error, and `hylc simulate`'s exit codes (0 complete, 2 bad input, 3 did not converge).
 
 mod common;
 

@@ -1,4 +1,4 @@
-//! `hylc identify` (issue 22, items 2–4) on small generated patterns with synthetic targets (no external data):
+//! `hylc identify` (`docs/yarn-parameters.md`) on small generated patterns with synthetic targets (no external data):
 //! the Jacobians of the residual sets a, b, c (from the equilibrium sensitivities and the envelope theorem)
 //! against central differences of complete re-evaluations, the identification recovering the parameters that
 //! made the target, and the one-line errors of bad input. The original patterns are in the `validation/identify/`

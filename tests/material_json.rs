@@ -1,5 +1,5 @@
 //! Material JSON: exact round trips, tolerated unknown keys, and one-line file-and-field errors for bad input
-//! (issue 2, "Bad input"), also through the CLI (exit code 2, no panic).
+//! (`docs/file-formats.md`, "Material (JSON)"), also through the CLI (exit code 2, no panic).
 
 mod common;
 

@@ -1,4 +1,4 @@
-//! The micro solver's command line on bad input and on non-converged solves (issue 4, "Bad input"): strains
+//! The micro solver's command line on bad input and on non-converged solves (`docs/robustness.md`): strains
 //! outside the admissible set give a one-line error naming the component; a solve stopped early is reported with
 //! its status and a non-zero exit code, and no Ψ̄.
 

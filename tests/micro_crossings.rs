@@ -1,5 +1,6 @@
-//! Yarn crossings along a motion (`hylc::contact::ccd`, `Tile::crossings`, `SolverOptions::crossings`; issue 19,
-//! item 1: the guard that keeps a start's equilibrium in the fabric it started in). Generated patterns only.
+//! Yarn crossings along a motion (`hylc::contact::ccd`, `Tile::crossings`, `SolverOptions::crossings`): the guard
+//! that keeps a start's equilibrium in the fabric it started in (`docs/sampling.md`, "The crossing guard").
+//! Generated patterns only.
 
 use hylc::contact::ccd::net_crossings;
 use hylc::contact::SegmentTopology;
@@ -73,7 +74,7 @@ fn a_weave_yarn_pushed_through_its_crossing_yarns_is_seen() {
 }
 
 /// The generated stockinette's cold start at the biaxial stretch (s_x, s_y) = (0.45, 0.96) pulls loops through
-/// each other (issue 19: a multi-start run kept 0.067 J/m² there, below the rest state's 0.75): counted, the path
+/// each other (a multi-start run kept 0.067 J/m² there, below the rest state's 0.75): counted, the path
 /// has crossings that do not cancel; rejected, the solve converges without any, to the stretched knit's energy
 /// (the warm chain's 124 J/m²), far above the rest state's.
 #[test]
@@ -187,7 +188,7 @@ fn a_warm_start_moved_to_its_strain_at_fixed_displacements_is_checked() {
     );
 }
 
-/// The knit case behind it (issue 19: held-out and `hylc run` samples that landed far below their neighbours):
+/// The knit case behind it (held-out and `hylc run` samples that landed far below their neighbours):
 /// the warm chain of `hylc run`'s (s_x, s_y) grid on the generated stockinette, (0.07, 0.07) → (−0.22, 0.07) →
 /// (−0.44, 0.07) → (−0.44, −0.22), predicts its start at (−0.44, −0.44) by the secant; the way there from the
 /// last equilibrium pulls yarns through each other before Newton's first step. The plain warm start (no

@@ -1,5 +1,5 @@
-//! Envelope-theorem derivatives of Ψ̄ against central differences of complete re-solves (`06-verification.md`,
-//! section 1: tolerance 1e-4 relative), on the generated plain weave (no external data needed).
+//! Envelope-theorem derivatives of Ψ̄ against central differences of complete re-solves (tolerance 1e-4 relative;
+//! `docs/derivative-harness.md`), on the generated plain weave (no external data needed).
 
 use hylc::generate::default_pattern;
 use hylc::micro::envelope::{parameter_derivatives, strain_derivatives, PARAMETER_NAMES};

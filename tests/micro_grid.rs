@@ -1,6 +1,6 @@
-//! Validation item 3c (`../shared/design/06-verification.md`): a quick partial run of the micro solver against the
+//! Validation item c (`docs/micro-vs-original.md`): a quick partial run of the micro solver against the
 //! original displacements on satin — a few grid points near z = 0 by warm-started continuation. The full grid is
-//! `hylc micro-grid` (README, "Micro solver against the original"). Skips without `../shared`.
+//! `hylc micro-grid` (`docs/micro-vs-original.md`, "Errors on the 9×9×9 grid"). Skips without `../shared`.
 
 mod common;
 

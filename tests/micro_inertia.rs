@@ -1,5 +1,5 @@
-//! Inertia-controlled Newton steps (`StepRule::Inertia`, the default; issue 20; `03-homogenization.md`,
-//! section 3), on the generated plain weave (no external data needed).
+//! Inertia-controlled Newton steps (`StepRule::Inertia`, the default; `docs/micro-solver.md`, "Inertia-controlled
+//! Newton steps"), on the generated plain weave (no external data needed).
 
 use hylc::generate::default_pattern;
 use hylc::micro::{MacroStrain, MicroProblem, Solution, SolverOptions, Status, StepRule};

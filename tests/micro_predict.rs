@@ -1,5 +1,5 @@
-//! The value-only tile evaluation of the line search (issue 20, item 2), on the generated plain weave (no external
-//! data needed). (The tangent predictor and the step options this file also tested were retired:
+//! The value-only tile evaluation of the line search (`docs/micro-solver.md`), on the generated plain weave (no
+//! external data needed). (The tangent predictor and the step options this file also tested were retired:
 //! `docs/notes/retired-micro-solver-rules.md`.)
 
 use hylc::generate::default_pattern;

@@ -1,6 +1,7 @@
-//! Equilibrium sensitivities dy*/dθ to the yarn parameters (issue 22, item 2) against central differences of
-//! complete re-solves (relative ≤ 1e-4, normwise over the unknowns with the angles as r θ), on the generated plain
-//! weave (no external data needed), at zero strain and at an in-plane strain.
+//! Equilibrium sensitivities dy*/dθ to the yarn parameters (`docs/yarn-parameters.md`, "Equilibrium sensitivities
+//! to the yarn parameters") against central differences of complete re-solves (relative ≤ 1e-4, normwise over the
+//! unknowns with the angles as r θ), on the generated plain weave (no external data needed), at zero strain and at
+//! an in-plane strain.
 
 use hylc::generate::default_pattern;
 use hylc::micro::sensitivity::{equilibrium_sensitivities, YarnParameter};

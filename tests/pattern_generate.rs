@@ -1,4 +1,4 @@
-//! Procedural pattern generators (`../shared/design/02-yarn-model.md`, "Periodic yarn pattern"): structure,
+//! Procedural pattern generators (`docs/yarn-model.md`): structure,
 //! frames, rest state, sampling, distances between centre lines, smoothness across the tile boundary,
 //! determinism, parameter errors, OBJ export and the `hylc generate` command.
 

@@ -1,4 +1,4 @@
-//! `.pyp` pattern files (`../shared/design/02-yarn-model.md`, "Periodic yarn pattern"): the five originals load,
+//! `.pyp` pattern files (`docs/file-formats.md`, "Yarn pattern (`.pyp`)"): the five originals load,
 //! round-trip to the last bit (and byte for byte up to line ends), basket gets its period warning; every kind of
 //! bad input gives one line naming file, block and line, and no input panics. Tests of the originals read them
 //! from `../shared` and skip with a message when it is absent; the rest use a small hand-made tile.

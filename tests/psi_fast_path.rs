@@ -1,4 +1,4 @@
-//! The fast ψ path (`Material::eval`; `05-macro.md`, "Material ψ(z)") equals the formula it implements, to
+//! The fast ψ path (`Material::eval`; `docs/material.md`, "The fast path") equals the formula it implements, to
 //! round-off, at strains chosen to reach every branch: in-plane strains on knots, between knots and beyond the knot
 //! ranges; bending with equal eigenvalues (umbilic, the polynomial branch at d = 0), both eigenvalues on one piece
 //! (polynomial branch), on different pieces (divided differences), an eigenvalue exactly on a knot, and both beyond

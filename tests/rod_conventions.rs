@@ -1,4 +1,4 @@
-//! The rod conventions of `02-yarn-model.md` against the five original patterns: the stored reference twists are
+//! The rod conventions of `docs/yarn-model.md` against the five original patterns: the stored reference twists are
 //! reproduced from the stored reference directors, and the stored rest curvatures and twists agree with the
 //! curvatures and twists measured at the stored state (up to the rest-shape scaling of Algorithm C1).
 //!
@@ -128,7 +128,7 @@ fn stored_rest_curvatures_follow_the_conventions() {
                     "{name}: {corr} {ratio}"
                 )
             }
-            // the tight knits are not equilibria of the stored rest shape (02-yarn-model.md); their curvatures
+            // the tight knits are not equilibria of the stored rest shape (docs/yarn-model.md); their curvatures
             // still follow the stored ones closely
             _ => assert!(corr > 0.85 && ratio > 0.5, "{name}: {corr} {ratio}"),
         }

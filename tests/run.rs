@@ -1,4 +1,4 @@
-//! The main job end to end (issue 7; `01-architecture.md`, "Command line": `run`) on a small configuration: the
+//! The main job end to end (`hylc run`; `docs/pipeline.md`, "`hylc run`") on a small configuration: the
 //! plain weave, a 7-per-range / 5×5 plan, a 3 cm mesh and 0.05 s of drape. Every stage writes its outputs, the
 //! material loads and is ψ(0)-consistent with the fit report, the summary names the stages, and a rerun resumes
 //! (no sample solved twice, the reference state reused). Also `scene-plan` on the run's strain log.

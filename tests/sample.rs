@@ -1,4 +1,4 @@
-//! Sampling runs (issue 5, "Resume"; `04-sampling-fitting.md`, "Sampling plan (C4)"): a run resumed after its
+//! Sampling runs (`docs/sampling.md`: resume, shards): a run resumed after its
 //! sample file was cut mid-line, or after the CLI was killed with SIGKILL, writes the same records as an
 //! uninterrupted run (Ψ̄ and stresses bitwise); shards merged equal the unsharded run.
 

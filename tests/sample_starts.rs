@@ -1,6 +1,6 @@
-//! Multi-start samples (issue 19, item 1, "A defined Ψ̄"): `--starts warm+cold` keeps the lowest converged Ψ̄ of
-//! the warm and the cold start, records every start and the one kept, leaves the warm chain as it was, and gives
-//! the same records resumed or sharded; `hylc compare-samples` lists the samples where two files disagree.
+//! Multi-start samples (`docs/sampling.md`, "Multi-start samples"): `--starts warm+cold` keeps the lowest converged Ψ̄
+//! of the warm and the cold start, records every start and the one kept, leaves the warm chain as it was, and gives the
+//! same records resumed or sharded; `hylc compare-samples` lists the samples where two files disagree.
 
 mod common;
 
@@ -118,7 +118,7 @@ fn warm_and_cold_resumed_and_sharded_give_the_same_records() {
     std::fs::remove_dir_all(&d).ok();
 }
 
-/// The plain weave under the design's shift rule (`StepRule::Shift`): there the tiny plan has samples
+/// The plain weave under the shift rule (`StepRule::Shift`): there the tiny plan has samples
 /// in mid-chain whose warm and cold starts disagree, which this test needs (with the inertia rule, the default,
 /// no disagreement of the tiny plan is both above the default threshold and continued by a later step, so no
 /// reversed start is made).

@@ -1,5 +1,5 @@
-//! Macro-scale tests (issue 6): patch tests (uniform deformation, cylinder, rigid motions), the quasi-static
-//! uniaxial strip against ∂ψ/∂s_x, and bad input (OBJ and scene files).
+//! Macro-scale tests (`docs/cloth-simulator.md`): patch tests (uniform deformation, cylinder, rigid motions), the
+//! quasi-static uniaxial strip against ∂ψ/∂s_x, and bad input (OBJ and scene files).
 
 mod common;
 

@@ -1,6 +1,6 @@
-//! The fold and collapse barriers (issue 18, `hylc::shell::fold`): a hinge approaching the flat fold (|θ| → π)
-//! or a triangle approaching zero area costs unbounded energy and is pushed back; below the thresholds nothing
-//! changes; the PSD options treat the fold barrier's Hessian as documented; the derivative harness's barrier
+//! The fold and collapse barriers (`hylc::shell::fold`; `docs/cloth-simulator.md`): a hinge approaching the flat fold
+//! (|θ| → π) or a triangle approaching zero area costs unbounded energy and is pushed back; below the thresholds
+//! nothing changes; the PSD options treat the fold barrier's Hessian as documented; the derivative harness's barrier
 //! rows sample states beyond their thresholds; scenes have both by default and turn them off with `null`.
 
 use hylc::checks::shell::sample_stencil;

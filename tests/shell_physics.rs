@@ -1,9 +1,9 @@
-//! Issue 18, the physics of the original's scenes in our incremental-potential solver: lagged Coulomb friction
-//! (a cloth on a tilted plane sticks below the friction angle and slides above it with Coulomb's acceleration),
-//! air drag (terminal velocity ρ_A g = ρ v²), stiffness-proportional damping (dissipates), handle springs (their
-//! reaction is the spring force and tends to the hard constraint's as k grows), triangle-mesh obstacles (a
-//! cloth comes to rest on a closed mesh without passing through it; a non-manifold mesh is refused) and
-//! adaptive substeps.
+//! The physics of the original's scenes in our incremental-potential solver (`docs/cloth-simulator.md`): lagged Coulomb
+//! friction (a cloth on a tilted plane sticks below the friction angle and slides above it with Coulomb's
+//! acceleration), air drag (terminal velocity ρ_A g = ρ v²), stiffness-proportional damping (dissipates), handle
+//! springs (their reaction is the spring force and tends to the hard constraint's as k grows), triangle-mesh obstacles
+//! (a cloth comes to rest on a closed mesh without passing through it; a non-manifold mesh is refused) and adaptive
+//! substeps.
 
 use hylc::checks::shell_external::icosahedron;
 use hylc::shell::scene::{self, MeshSpec, ObstacleSpec, Placement, Scene, Transform};

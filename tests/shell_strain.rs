@@ -1,7 +1,7 @@
 //! Conformance of the strain chain z(q) with the original macro-scale code (`../shared/oracles/strain_oracle.json`,
-//! `06-verification.md` 3a; `hylc::validation::conformance::strain_conformance`): value, 6×18 Jacobian and 6×18×18 Hessian (each
-//! z_k's Hessian is the weighted Hessian with the unit weight e_k) within 1e-10 relative normwise, at the stored
-//! positions and translated 2 m from the origin.
+//! validation item a of `docs/results.md`; `hylc::validation::conformance::strain_conformance`): value, 6×18 Jacobian
+//! and 6×18×18 Hessian (each z_k's Hessian is the weighted Hessian with the unit weight e_k) within 1e-10 relative
+//! normwise, at the stored positions and translated 2 m from the origin.
 
 mod common;
 

@@ -30,7 +30,7 @@ fn shift() -> SolverOptions {
     }
 }
 
-/// The problem hash reads the settings in their version-1 form, unchanged: the text of the defaults, of the design
+/// The problem hash reads the settings in their version-1 form, unchanged: the text of the defaults, of the shift
 /// rule and of the crossing guard is byte for byte what hylc hashed before the version key.
 #[test]
 fn the_hash_text_is_the_version_1_form() {

@@ -1,5 +1,5 @@
-//! The whole-tile energy (`02-yarn-model.md`) and the calibration against the original patterns
-//! (`06-verification.md` item b).
+//! The whole-tile energy (`docs/yarn-model.md`) and the calibration against the original patterns
+//! (`docs/yarn-model.md`, "Calibration"; validation item b).
 
 mod common;
 

@@ -1,5 +1,6 @@
-//! `hylc validate` (issue 7; `06-verification.md`, section 3) on a quick setting: the results table has rows for
-//! items a–d with the conformance rows met, and `--readme` replaces exactly the text between the markers.
+//! `hylc validate` (`docs/results.md`, "Validation against the original (`hylc validate`)") on a quick setting: the
+//! results table has rows for items a–d with the conformance rows met, and `--readme` replaces exactly the text between
+//! the markers.
 
 mod common;
 

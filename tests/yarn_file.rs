@@ -1,6 +1,6 @@
-//! Yarn parameters as data (issue 22, item 1): `hylc yarn` writes the JSON form that `--yarn FILE` reads on every
-//! command that solves; bad files are one-line errors naming file and key; sample sidecars record the yarn used,
-//! and sidecars from before the contact radius factor still read.
+//! Yarn parameters as data (`docs/yarn-parameters.md`, "Yarn parameters as data (`--yarn FILE`)"): `hylc yarn` writes
+//! the JSON form that `--yarn FILE` reads on every command that solves; bad files are one-line errors naming file and
+//! key; sample sidecars record the yarn used, and sidecars from before the contact radius factor still read.
 
 mod common;
 

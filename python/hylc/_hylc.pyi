@@ -364,7 +364,7 @@ class MicroProblem:
     quadrature : int, optional
         Gauss points per segment of the contact quadrature (default the yarn's, 4).
     inertia : bool, default True
-        The inertia-controlled Newton steps; False is ``hylc solve --no-inertia`` (the design's shift rule).
+        The inertia-controlled Newton steps; False is ``hylc solve --no-inertia`` (the shift rule).
 
     Raises
     ------

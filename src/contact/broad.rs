@@ -21,7 +21,7 @@
 //! |k_b − k_a + n m| segments (W ≠ 0), or the shorter way around the loop min(|Δ|, m − |Δ|) (W = 0). Pairs with a
 //! separation of at most `exclusion` segments (`YarnMaterial::contact_exclusion`, "3 neighbouring segments on each
 //! side") are skipped. Segments of different yarns, or of different copies of one yarn (o − o_{k_b} + o_{k_a} not a
-//! multiple of W, e.g. the neighbouring parallel copy of a weft yarn), are never excluded. This is the design's
+//! multiple of W, e.g. the neighbouring parallel copy of a weft yarn), are never excluded. This is the method's
 //! "shorter way along the closed yarn" measured on the physical (unrolled) yarn, so a segment near the tile border
 //! and its neighbour's copy across the border count as neighbours. Separation is counted in segments (the unit of
 //! `contact_exclusion`), not in metres.

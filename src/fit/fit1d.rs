@@ -47,7 +47,7 @@ pub enum SlopeSource {
     Stress,
 }
 
-/// FIT1D parameters; [`Default`] gives the design's defaults for an in-plane strain.
+/// FIT1D parameters; [`Default`] gives the defaults for an in-plane strain (`docs/fitting.md`).
 #[derive(Clone, Debug)]
 pub struct Fit1DOptions {
     /// N_c, the knot count that sets the spacing h (default 11)
@@ -67,7 +67,7 @@ pub struct Fit1DOptions {
     pub fd_step: f64,
     /// slope source (default finite differences)
     pub slopes: SlopeSource,
-    /// the knots' extent as a fraction of the sample range (step 2; default 0.95, the design's): beyond the last
+    /// the knots' extent as a fraction of the sample range (step 2; default 0.95): beyond the last
     /// knot the term continues linearly
     pub extent: f64,
 }
@@ -199,7 +199,7 @@ impl<T: FitScalar> Smoothed<T> {
 }
 
 /// Step 2's knots: the multiples k h, k = k_lo..=k_hi, of h = e (hi − lo)/(N_c − 1) inside [e lo, e hi], e the
-/// extent (the design's 0.95).
+/// extent (default 0.95).
 struct Knots {
     t: Vec<f64>,
     h: f64,

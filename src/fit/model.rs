@@ -26,14 +26,14 @@ use crate::sample::{Plan, Record, Sample};
 use crate::strain::StrainComponent;
 use serde::Serialize;
 
-/// Options of the whole fit; [`Default`] gives the design's defaults. A fitted material records them in its
-/// `meta["fit options"]` (the same keys), so that it can be refitted as it was made.
+/// Options of the whole fit; [`Default`] gives the default fit (`docs/fitting.md`). A fitted material records them
+/// in its `meta["fit options"]` (the same keys), so that it can be refitted as it was made.
 #[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct FitOptions {
     /// N_c of FIT1D (default 11)
     pub n_knots_1d: usize,
-    /// FIT1D's knot extent as a fraction of each 1D range (default 0.95, the design's)
+    /// FIT1D's knot extent as a fraction of each 1D range (default 0.95)
     pub extent_1d: f64,
     /// knots per axis of FIT2D (default 9)
     pub n_knots_2d: usize,
@@ -57,9 +57,9 @@ pub struct FitOptions {
     /// is still measured on the whole range, so the other samples are held out (a sampling-density study)
     pub thin_1d: usize,
     /// FIT2D step 7′ instead of 7 on the pairs with one stretch axis ([`Fit2DOptions::compression_residual`];
-    /// default false: the design's zero-compression residual)
+    /// default false: step 7's zero-compression residual)
     pub compression_residual: bool,
-    /// symmetrise the MLS of every term in s_a (default true, the design's FIT1D/FIT2D step 1: Ψ̄ even in s_a);
+    /// symmetrise the MLS of every term in s_a (default true, FIT1D/FIT2D step 1: Ψ̄ even in s_a);
     /// false fits the two signs of shear separately (the knits' Ψ̄ is not even: honeycomb's rest state carries a
     /// shear stress, and its Ψ̄ at s_a = ±0.75 is 3.43 against 2.31 J/m²)
     pub symmetric_shear: bool,
@@ -110,7 +110,7 @@ impl FitOptions {
         }
     }
 
-    /// The design's settings for stockinette-like patterns: pˣ_min = 0.01, and the pairs with a bending strain
+    /// The method's settings for stockinette-like patterns: pˣ_min = 0.01, and the pairs with a bending strain
     /// with 5 knots per axis on 0.3 of the range (the layout of the original stock1 material; its in-plane pairs
     /// keep 0.9).
     pub fn stockinette_like() -> Self {
@@ -273,8 +273,8 @@ pub fn strain6(z: &[f64; 5]) -> [f64; 6] {
 }
 
 /// The largest |Ψ̄| (J/m²) and |∂Ψ̄/∂z_k| (J/m² per unit strain; J/m per 1/m for bending) a sample record may
-/// carry into a fit. The default yarn (E = 1 MPa, r = 1 mm) gives Ψ̄ of order 10⁻²–10 J/m² over the design's
-/// ranges, and yarns 10⁵ times stiffer stay below 10⁷; 10¹² leaves ample room while keeping every sum of squares
+/// carry into a fit. The default yarn (E = 1 MPa, r = 1 mm) gives Ψ̄ of order 10⁻²–10 J/m² over the default
+/// plan's ranges, and yarns 10⁵ times stiffer stay below 10⁷; 10¹² leaves ample room while keeping every sum of squares
 /// the fit forms (10²⁴ per sample, at most 10⁶ samples per plan) far from overflow, so a fit never turns finite
 /// data into NaN. Larger values (a corrupted or hand-edited file) are an error naming the file, the sample and
 /// the value ([`check_records`]).

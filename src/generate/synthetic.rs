@@ -1,4 +1,4 @@
-//! A synthetic periodic weave for tests and benchmarks (not a generator of the design: no reference state).
+//! A synthetic periodic weave for tests and benchmarks (not one of the pattern generators: no reference state).
 
 use crate::pattern::{Edge, Pattern};
 use nalgebra::Vector3;

@@ -3,7 +3,7 @@
 //!
 //! **Settings files.** The settings are written as JSON with a `version` key ([`SETTINGS_VERSION`], every key
 //! written; a key left out of a file reads as its default). A settings object without `version` is one written
-//! before that key existed (version 1): it loads with that version's reading (a missing `inertia` key is the design
+//! before that key existed (version 1): it loads with that version's reading (a missing `inertia` key is the shift
 //! rule, [`StepRule::Shift`], the rule such files were made with). Version 1 also had options of micro-solver rules
 //! that were measured and not adopted (`docs/notes/retired-micro-solver-rules.md`); a version-1 object that sets
 //! one of them to anything but its default value is refused with a message naming the option.
@@ -22,7 +22,7 @@ pub const SETTINGS_VERSION: u32 = 2;
 pub struct SolverOptions {
     /// Dimensionless force tolerance: converged when ‖g‖_∞ ≤ tolerance · k_s.
     pub tolerance: f64,
-    /// Newton-decrement test: converged when |gᵀδy| ≤ decrement_tolerance · (|E| + k_s r) (design default
+    /// Newton-decrement test: converged when |gᵀδy| ≤ decrement_tolerance · (|E| + k_s r) (default
     /// 1e-14). For a small tile this is looser than the force test (|E| ≪ k_s r), so derivative checks against
     /// re-solves set it to 0 and rely on the force test alone.
     pub decrement_tolerance: f64,
@@ -36,7 +36,7 @@ pub struct SolverOptions {
     /// Broad-phase margin in units of r.
     pub contact_margin: f64,
     /// How a Newton step treats an indefinite Hessian ([`StepRule`]): inertia-controlled steps (the default) or
-    /// the design's shift rule alone (reproduces the solver and the sample files from before 5 December 2026).
+    /// the shift rule alone (reproduces the solver and the sample files from before 5 December 2026).
     pub step_rule: StepRule,
     /// Yarn crossings along the Newton path ([`crate::contact::ccd`]; docs/sampling.md): not checked (the
     /// default), counted (each accepted step is tested; [`crate::micro::Solution::crossings`]), or rejected (a
@@ -67,8 +67,8 @@ impl Default for SolverOptions {
     }
 }
 
-/// How a Newton step treats a Hessian H that is not positive definite (`docs/micro-solver.md`, section 3; issue
-/// 20).
+/// How a Newton step treats a Hessian H that is not positive definite (`docs/micro-solver.md`, "Inertia-controlled
+/// Newton steps").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum StepRule {
@@ -76,12 +76,12 @@ pub enum StepRule {
     /// exact constrained Newton step when the KKT matrix has the inertia of a constrained minimum (H positive
     /// definite on the null space of the constraint rows, even where it is indefinite along them: a yarn held
     /// back from sliding) and the energy then falls by at least a quarter of the decrease the quadratic model
-    /// predicts; otherwise the step is the design's: μ grown ×10 until the (inertia-tested) shifted step exists,
+    /// predicts; otherwise the step is the shift rule's: μ grown ×10 until the (inertia-tested) shifted step exists,
     /// with backtracking. A backtracked step whose predicted decrease is at round-off level
     /// (≤ 1e-11 (|E| + k_s r)) ends the solve as converged. Measured in docs/notes/micro-solver-speed.md.
     #[default]
     Inertia,
-    /// The design's rule alone: μ grown ×10 until H + μI is positive definite in the full space, with
+    /// The shift rule alone: μ grown ×10 until H + μI is positive definite in the full space, with
     /// backtracking (`--no-inertia`). It reproduces the solver before 5 December 2026 bit for bit, the results
     /// measured with it and the sample files made with it.
     Shift,

@@ -159,7 +159,7 @@ pub struct Solution {
     pub area: f64,
     /// The largest regularisation μ used (N/m).
     pub max_mu: f64,
-    /// Of the steps, the exact constrained Newton steps of [`StepRule::Inertia`] taken where the design's rule
+    /// Of the steps, the exact constrained Newton steps of [`StepRule::Inertia`] taken where the shift rule
     /// would have shifted μ above its floor.
     pub exact_steps: usize,
     /// Yarn crossings of the accepted steps ([`SolverOptions::crossings`] `count`; empty otherwise).

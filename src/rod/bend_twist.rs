@@ -72,7 +72,7 @@ pub struct BendTwistParams {
     pub bend: f64,
     /// Twisting stiffness GJ.
     pub twist: f64,
-    /// How the curvature measures the turning angle (`Tan`: the design's 2 tan(φ/2)).
+    /// How the curvature measures the turning angle (`Tan`: 2 tan(φ/2), the original's form).
     pub form: BendingForm,
 }
 

@@ -18,7 +18,7 @@ pub fn transport(a: &Vector3<f64>, b: &Vector3<f64>, x: &Vector3<f64>) -> Vector
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum BendingForm {
-    /// k(φ) = 2 tan(φ/2) (Bergou et al.): κb = 2 e⁰ × e¹ / (|e⁰||e¹| + e⁰·e¹); the design's form.
+    /// k(φ) = 2 tan(φ/2) (Bergou et al.): κb = 2 e⁰ × e¹ / (|e⁰||e¹| + e⁰·e¹); the original's form.
     #[default]
     Tan,
     /// k(φ) = 2 sin(φ/2): κb = 2 e⁰ × e¹ / √(2 |e⁰||e¹| (|e⁰||e¹| + e⁰·e¹)), bounded as φ → π (the bending-discretisation

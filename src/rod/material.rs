@@ -39,7 +39,7 @@ pub struct YarnMaterial {
     pub contact_exclusion: usize,
     /// Contact radius factor f: the contact distance is 2 f r (1: the yarns touch at their surfaces).
     pub contact_radius_factor: f64,
-    /// How the discrete curvature measures a turning angle φ: `"tan"` (2 tan(φ/2), the design's form) or `"sin"`
+    /// How the discrete curvature measures a turning angle φ: `"tan"` (2 tan(φ/2), the original's form) or `"sin"`
     /// (2 sin(φ/2)); rest curvatures, stored in the `tan` form, keep their angles. The one key added after the
     /// format was fixed: a file without it means `"tan"`, the form every earlier file was made with.
     #[serde(default)]

@@ -3,7 +3,7 @@
 //! axis, keep it there as a non-negative excess that is monotone outward from the axes.
 //!
 //! The knits couple compression with shear strongly (honeycomb: Ψ̄ = 320 J/m² at (s_x, s_a) = (−0.26, 0.75) where
-//! the additive model gives 3.5), which the design's zero-compression residual cannot represent. On the block of
+//! the additive model gives 3.5), which step 7's zero-compression residual cannot represent. On the block of
 //! knots with the stretch coordinate ≤ 0 (u ≤ 0 when u is the stretch axis, v ≤ 0 when v is):
 //!
 //! 1. the line of the stretch axis' knot 0 stays zero (p = pˣ = pʸ = pˣʸ = 0, as step 7 leaves it, so the

@@ -56,7 +56,7 @@ use super::FitError;
 use crate::material::Hermite2D;
 use certify::nonnegative;
 
-/// FIT2D parameters; [`Default`] gives the design's defaults for a pair of in-plane strains other than s_a.
+/// FIT2D parameters; [`Default`] gives the defaults for a pair of in-plane strains other than s_a.
 #[derive(Clone, Debug)]
 pub struct Fit2DOptions {
     /// knots per axis (u, v) including 0 (default 9 each; the original uses 8–10)

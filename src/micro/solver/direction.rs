@@ -1,5 +1,5 @@
 //! The Newton direction of one micro-solver iteration (`docs/micro-solver.md`, sections 3–4, step 3): the KKT
-//! step with the regularisation μ grown ×10 until it exists (the design's rule), and the exact constrained step of
+//! step with the regularisation μ grown ×10 until it exists (the shift rule), and the exact constrained step of
 //! [`StepRule::Inertia`] tried first.
 
 use super::*;
@@ -18,7 +18,7 @@ impl<'p> NewtonRun<'p> {
         self.shifted_direction(g)
     }
 
-    /// [`StepRule::Inertia`]: store the Hessian of `ev`; where the design's rule would start above μ's floor,
+    /// [`StepRule::Inertia`]: store the Hessian of `ev`; where the shift rule would start above μ's floor,
     /// the exact constrained Newton step at the floor when the KKT matrix there has the inertia of a constrained
     /// minimum; `None` otherwise, and [`NewtonRun::shifted_direction`] goes on from μ (its shifts accepted by the
     /// same inertia test). μ keeps its value, the shifted search's memory.

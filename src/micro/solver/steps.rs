@@ -4,11 +4,11 @@
 
 use super::*;
 
-/// The line search's backtracking factor: trial steps 0.1ⁱ down to 1e-10 (the design's).
+/// The line search's backtracking factor: trial steps 0.1ⁱ down to 1e-10.
 const BACKTRACKING: f64 = 0.1;
 
 /// [`StepRule::Inertia`]: the exact Newton step is kept when the energy falls by at least this fraction of
-/// the decrease its quadratic model predicts; otherwise the step is the design's shifted one.
+/// the decrease its quadratic model predicts; otherwise the step is the shifted one of [`StepRule::Shift`].
 const EXACT_STEP_RATIO: f64 = 0.25;
 
 impl<'p> NewtonRun<'p> {

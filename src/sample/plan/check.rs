@@ -7,7 +7,7 @@ use crate::strain::StrainComponent;
 use std::path::Path;
 
 /// The most samples a plan may have (1D ranges, 2D grids and in-plane grid together), and so the largest any one
-/// count (`count_1d`, `count_2d`, an entry of `counts_1d` / `counts_2d`, an axis of `grid`) may be. The design's
+/// count (`count_1d`, `count_2d`, an entry of `counts_1d` / `counts_2d`, an axis of `grid`) may be. The
 /// default plan has 23 250 samples; 10⁶ is 43 times that, weeks of solves on a workstation, while the enumeration
 /// ([`Plan::samples`], about 100 bytes a sample) stays near 100 MB. Checked (with overflow-free arithmetic) by
 /// [`Plan::validate`] before anything is allocated.

@@ -17,7 +17,7 @@ pub use check::{
 use crate::strain::StrainComponent;
 use serde::{Deserialize, Serialize};
 
-/// SAMPLERANGE(z, z_min, z_max, N) of the design: for the stretches s_x, s_y (`k` = 0, 2)
+/// SAMPLERANGE(z, z_min, z_max, N) (`docs/sampling.md`): for the stretches s_x, s_y (`k` = 0, 2)
 /// Z = linspace((z_min+1)^(1/10), (z_max+1)^(1/10), N)^10 − 1 (denser towards compression); for s_a, Π₀₀, Π₁₁
 /// (`k` = 1, 3, 4) Z = linspace(−√|z_min|, √|z_max|, N), then Z = sgn(Z) Z² (denser near 0).
 /// `n` = 1 gives the lower end (as `linspace` does).
@@ -50,7 +50,7 @@ pub fn sample_range(k: usize, z_min: f64, z_max: f64, n: usize) -> Vec<f64> {
     }
 }
 
-/// Per-strain ranges [min, max] (design defaults: s_x, s_y ∈ [−0.6, 0.96], s_a ∈ [−0.7, 0.7], Π ∈ [−160, 160]
+/// Per-strain ranges [min, max] (defaults: s_x, s_y ∈ [−0.6, 0.96], s_a ∈ [−0.7, 0.7], Π ∈ [−160, 160]
 /// m⁻¹).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -165,7 +165,7 @@ impl InPlaneGrid {
     }
 }
 
-/// The design's nine pairs: {s_x,s_a,s_y}² unordered distinct, then {s_x,s_a,s_y}×{Π₀₀,Π₁₁}.
+/// The default plan's nine pairs: {s_x,s_a,s_y}² unordered distinct, then {s_x,s_a,s_y}×{Π₀₀,Π₁₁}.
 pub fn default_pairs() -> Vec<[StrainComponent; 2]> {
     use StrainComponent::*;
     vec![
@@ -185,7 +185,7 @@ pub fn default_pairs() -> Vec<[StrainComponent; 2]> {
 pub const QUICK_BENT_COMPRESSION: f64 = -0.44;
 
 impl Default for Plan {
-    /// The design's default plan: 5 × 150 + 9 × 50² = 23 250 samples.
+    /// The default plan: 5 × 150 + 9 × 50² = 23 250 samples.
     fn default() -> Self {
         Plan {
             ranges: Ranges::default(),

@@ -13,7 +13,7 @@ use crate::shell::{Mesh, Psd, ShellError};
 
 use Key::{Ignored, Used};
 
-/// ARCSim's defaults for keys a scene may leave out (its `conf.cpp`, and the issue for the magic numbers):
+/// ARCSim's defaults for keys a scene may leave out (its `conf.cpp`; the key mapping in `docs/arcsim.md`):
 /// `wind.density` 1, `magic.handle_stiffness` 1e3 N/m, `magic.repulsion_thickness` 1e-3 m, `obs_friction` 0.3,
 /// `gravity` zero, `frame_steps` 1.
 pub const DEFAULT_WIND_DENSITY: f64 = 1.0;
