@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Structure metrics of the crate's source tree, for a refactoring issue's before/after report.
+"""Structure metrics of the crate's source tree, for a refactoring's before/after report.
 
 usage: python3 validation/code_metrics.py [--rev REV] [--json]
        python3 validation/code_metrics.py --max-lines N

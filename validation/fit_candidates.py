@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""Held-out error of fitted materials on the 9x9x9 in-plane grid of a sample file (issue 19, item 2: the candidate
-table). For each material: relative RMS and max over all converged held-out samples (as `hylc fit` reports them),
-and over the samples consistent with their s_a mirror: Psi-bar is even in s_a (04-sampling-fitting.md, FIT1D step
-1), so a held-out sample whose energy differs from that of (s_x, -s_a, s_y) by more than TOL (default 0.25) of the
-larger of the two sits on another equilibrium branch than its mirror (issue 19, item 1); those are counted and
-listed, not hidden. The fit error is the model's RMS / max on all fitted samples, from the material's meta block.
+"""Held-out error of fitted materials on the 9x9x9 in-plane grid of a sample file (the candidate table of
+`docs/results.md`, "Held-out error with a defined Ψ̄"). For each material: relative RMS and max over all converged
+held-out samples (as `hylc fit` reports them), and over the samples consistent with their s_a mirror: Psi-bar is even in
+s_a (FIT1D step 1, `docs/fitting.md`), so a held-out sample whose energy differs from that of (s_x, -s_a, s_y) by more
+than TOL (default 0.25) of the larger of the two sits on another equilibrium branch than its mirror (`docs/sampling.md`,
+"Multi-start samples"); those are counted and listed, not hidden. The fit error is the model's RMS / max on all fitted
+samples, from the material's meta block.
 
 usage: validation/fit_candidates.py SAMPLES.jsonl MATERIAL.json [MATERIAL.json ...]   (HYLC: binary, TOL)
 """

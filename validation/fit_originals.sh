@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# Validation of sampling and fitting (issue 5; `../shared/design/06-verification.md`, item 3d) on the five original
-# patterns. For each pattern, one sample run of `validation/plans/<pattern>.json`: the five 1D ranges (150 samples
-# each, over the range the original material was fitted on: its knot span / 0.95 times its strain scale), the
-# three in-plane 2D grids (20×20), and the 9×9×9 in-plane grid of the original displacement data, which is held
-# out (never fitted, only predicted). Then `hylc fit` against the original material (`--compare`).
-# Writes validation/fit/<pattern>.{jsonl,meta.json,material.json,fit.json,plots/} and prints the tables.
+# Validation of sampling and fitting (validation item d; `docs/results.md`, "Fitted materials of the original patterns")
+# on the five original patterns. For each pattern, one sample run of `validation/plans/<pattern>.json`: the five 1D
+# ranges (150 samples each, over the range the original material was fitted on: its knot span / 0.95 times its strain
+# scale), the three in-plane 2D grids (20×20), and the 9×9×9 in-plane grid of the original displacement data, which is
+# held out (never fitted, only predicted). Then `hylc fit` against the original material (`--compare`). Writes
+# validation/fit/<pattern>.{jsonl,meta.json,material.json,fit.json,plots/} and prints the tables.
 #
 #   cargo build --release && validation/fit_originals.sh            # all five (the four other than basket: 81 min on 2 cores, 61 of them rib)
 #   validation/fit_originals.sh basket satin                        # some of them

@@ -1,10 +1,10 @@
 #!/usr/bin/env bash
-# The held-out 9×9×9 error of the knits with a defined Ψ̄ (issue 19; README, "Extending the model", the rows "the
-# way to each start checked too"): per pattern, the wide plan sampled with the crossing guard (stockinette and rib
-# `--crossings reject`, honeycomb `--starts warm+cold`), fitted with and without `--compression-residual
-# --asymmetric-shear`; the held-out grid sampled on its own with `--starts warm+cold` (the lowest in-fabric
-# equilibrium of the warm and the cold start, every start's way checked); then `fit_candidates.py` (all held-out
-# samples and the mirror-consistent ones).
+# The held-out 9×9×9 error of the knits with a defined Ψ̄ (`docs/results.md`, "Held-out error with a defined Ψ̄", the
+# rows "the way to each start checked too"): per pattern, the wide plan sampled with the crossing guard (stockinette and
+# rib `--crossings reject`, honeycomb `--starts warm+cold`), fitted with and without `--compression-residual
+# --asymmetric-shear`; the held-out grid sampled on its own with `--starts warm+cold` (the lowest in-fabric equilibrium
+# of the warm and the cold start, every start's way checked); then `fit_candidates.py` (all held-out samples and the
+# mirror-consistent ones).
 #
 #   cargo build --release && validation/heldout_guarded.sh                    # the three knits (about 1 h CPU)
 #   validation/heldout_guarded.sh slip_stitch_honeycomb                       # one of them

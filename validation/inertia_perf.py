@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Inertia-controlled Newton steps against the design's shift rule (issue 20): each chain of the reduced plan
-solved twice with the same binary, `--no-inertia` (the design rule, bitwise the solver before the change) and the
-default, one chain per process with RAYON_NUM_THREADS=1 so that the CPU time (user + sys of the child, from
-getrusage) is the solve's own. Prints the speed table (Newton steps, warm median / mean, CPU time, ratio) and the
-accuracy table (Ψ̄ of samples converged in both, moved by more than 1e-8 relative, lower / higher).
+"""Inertia-controlled Newton steps against the shift rule (`docs/micro-solver.md`, "Inertia-controlled Newton steps"):
+each chain of the reduced plan solved twice with the same binary, `--no-inertia` (the design rule, bitwise the solver
+before the change) and the default, one chain per process with RAYON_NUM_THREADS=1 so that the CPU time (user + sys of
+the child, from getrusage) is the solve's own. Prints the speed table (Newton steps, warm median / mean, CPU time,
+ratio) and the accuracy table (Ψ̄ of samples converged in both, moved by more than 1e-8 relative, lower / higher).
 
 Resumable: sample files and their CPU times stay in validation/inertia_perf/ (not committed); delete a pair of
 files to measure that chain again.

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Micro-solver performance on the five original patterns (issue 4, "Performance"): Newton steps and wall time per
+"""Micro-solver performance on the five original patterns (`docs/micro-solver.md`): Newton steps and wall time per
 solve, cold (from the reference state) and warm-started from the neighbouring strain of a chain, and where the
 time goes. Uses only the `hylc solve --json` timing output.
 

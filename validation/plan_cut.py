@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""What a sampling plan that stops short of the compressed corners would save and lose (issue 20, the default
-plan ≤ 30 min target). From one finished sample file (e.g. `hylc sample P.pyp --plan default --out P.jsonl`):
+"""What a sampling plan that stops short of the compressed corners would save and lose (target: the default
+plan in ≤ 30 min). From one finished sample file (e.g. `hylc sample P.pyp --plan default --out P.jsonl`):
 
 - the share of the summed solve time (the records' `time`) in the samples with s_x ≥ CUT and s_y ≥ CUT, for
   each CUT given: what a plan with those ranges would cost relative to the run;

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""How the cost per sample of a warm-started chain depends on the plan's density (issue 20, item 4: the
+"""How the cost per sample of a warm-started chain depends on the plan's density (the
 projected time of the default plan). The default plan has 150 samples per 1D range and 50 × 50 grids, the reduced
 plan 30 and 10 × 10; earlier projections scaled the reduced plan's CPU time by the sample counts (5× and 25×),
 i.e. assumed the reduced plan's cost per sample. This script runs chosen chains of the plan at several densities

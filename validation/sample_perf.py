@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Sampling performance (issue 5, "Performance"): wall time of the reduced plan (1 050 samples) on each original
-pattern, warm-started (continuation + secant predictor) and cold (`--cold`), the Newton steps, convergence, and the
-warm-versus-cold difference of Psi-bar (hysteresis: both converged, different equilibria). Uses the `hylc sample`
-sample files and its own timing line; resumable (a rerun skips finished samples but then reports only the new
-part's time, so delete validation/sample_perf/ for a fresh measurement).
+"""Sampling performance (`docs/results.md`, "Sampling cost"): wall time of the reduced plan (1 050 samples) on each
+original pattern, warm-started (continuation + secant predictor) and cold (`--cold`), the Newton steps, convergence, and
+the warm-versus-cold difference of Psi-bar (hysteresis: both converged, different equilibria). Uses the `hylc sample`
+sample files and its own timing line; resumable (a rerun skips finished samples but then reports only the new part's
+time, so delete validation/sample_perf/ for a fresh measurement).
 
 usage: validation/sample_perf.py [path/to/hylc] [pattern ...] > table.md
 """

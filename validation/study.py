@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The speed/accuracy study (issue 7; `../shared/design/06-verification.md`, section 4): for each knob users turn,
+"""The speed/accuracy study (`docs/results.md`, "Speed and accuracy (`validation/study.py`)"): for each knob users turn,
 the wall time and the error against a high-accuracy reference run of the same quantity, as Markdown tables.
 
 Knobs: micro solver tolerance, contact quadrature order, warm vs cold start, sampling density, knot counts (micro

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The built-in scenes with the original's basket1 (README, "Cloth results", "Scenes" table; issue 18 reran it
-# after the stretch strips moved to the original's handlebar geometry and steps became adaptive): each built-in
+# The built-in scenes with the original's basket1 (`docs/results.md`, "Built-in scenes"; the table was
+# rerun after the stretch strips moved to the original's handlebar geometry and steps became adaptive): each built-in
 # for 1 s at 1/60 s, PSD `psi` (and `full` for stretch-x); prints one table row per run from the run's log.
 #
 #   cargo build --release && validation/builtins/run.sh        # needs ../shared/data/hylc2020 (skips without it)

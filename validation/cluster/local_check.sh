@@ -2,7 +2,7 @@
 # Stand up a one-node Slurm on this machine, sample the reduced plan of the generated plain weave through
 # `slurm_sample.sh` with n = 4 shards, and check that the merged file equals the unsharded run (Ψ̄ bitwise, the same
 # ids); then the same with GNU parallel; then resume: a shard file cut short and the array re-submitted finishes
-# only the missing samples (issue 21). Not part of CI (≈ 10 min on 2 cores; installs Debian packages).
+# only the missing samples. Not part of CI (≈ 10 min on 2 cores; installs Debian packages).
 #
 #   validation/cluster/local_check.sh [WORKDIR]      (default WORKDIR: target/cluster-check)
 #

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Sample a plan on a Slurm cluster (issue 21): a job array of n shards (`hylc sample --shard k/n`, one sample file
-# per shard) and a merge job that runs after the whole array succeeded (`hylc merge`).
+# Sample a plan on a Slurm cluster (`docs/sampling.md`, "Sampling on a cluster"): a job array of n shards (`hylc sample
+# --shard k/n`, one sample file per shard) and a merge job that runs after the whole array succeeded (`hylc merge`).
 #
 #   validation/cluster/slurm_sample.sh PATTERN PLAN OUTDIR N [extra `hylc sample` flags...]
 #

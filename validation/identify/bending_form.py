@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Which discrete curvature did the original store its rest curvatures in? (issue 22, bending discretisation)
+"""Which discrete curvature did the original store its rest curvatures in? (`docs/yarn-parameters.md`, "Bending
+discretisation")
 
 For every vertex of the five original patterns: the turning angle phi between its two edges at the stored state,
 and the magnitude |RK| of the stored rest curvature (the `*RK` block of the .pyp file). If the rest shape is the

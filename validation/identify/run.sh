@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Identification of the yarn parameters from the original data (issue 22, items 3–5): `hylc identify` on the five
+# Identification of the yarn parameters from the original data (`docs/yarn-parameters.md`): `hylc identify` on the five
 # original patterns with the default residual set (a: stored-state equilibrium, b: the six grid points nearest
 # z = 0, c: the original material's s_x curve), after the conventions check. With VALIDATE=1 also the held-out
 # numbers before and after (the full 9×9×9 grid and the five 1D curves; about 2 × 5 min per pattern on 2 cores).

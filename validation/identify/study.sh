@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# What drives the fit (issue 22, item 6): for each original pattern, at the parameters `run.sh` identified
-# (validation/identify/<pattern>/identified.yarn.json), θ ∂Ψ̄/∂θ along the original material's five 1D ranges
-# (study.png) and the parameter correlations of the default residual set there (report.json), written to
+# What drives the fit (`docs/yarn-parameters.md`, "What drives the fit"): for each original pattern, at the parameters
+# `run.sh` identified (validation/identify/<pattern>/identified.yarn.json), θ ∂Ψ̄/∂θ along the original material's five
+# 1D ranges (study.png) and the parameter correlations of the default residual set there (report.json), written to
 # validation/identify/<pattern>/drivers/. Run run.sh first.
 #
 #   validation/identify/study.sh [pattern …]

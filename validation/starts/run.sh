@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# Multi-start samples (issue 19, item 1; README-starts.md): the cost and the effect of `hylc sample --starts` on the
-# reduced plans of the original rib and honeycomb. Per pattern, the plan is sampled warm (today's default), cold
-# (`--cold`), warm+cold and all (MODES); reported: wall time per mode, samples whose kept Ψ̄ changes against warm (count, by
-# how much), and the warm-first vs cold-first agreement (`hylc compare-samples`, relative tolerance $REL).
+# Multi-start samples (`docs/sampling.md`, "Multi-start samples"): the cost and the effect of `hylc sample --starts` on
+# the reduced plans of the original rib and honeycomb. Per pattern, the plan is sampled warm (today's default), cold
+# (`--cold`), warm+cold and all (MODES); reported: wall time per mode, samples whose kept Ψ̄ changes against warm
+# (count, by how much), and the warm-first vs cold-first agreement (`hylc compare-samples`, relative tolerance $REL).
 #
 #   cargo build --release && validation/starts/run.sh           # needs ../shared/data/hylc2020 (skips without it)
 #   PATTERNS=rib SHARD=0/14 validation/starts/run.sh            # a subset: shard k/n of the plan's chains
