@@ -100,7 +100,12 @@ impl ElementModel {
             }
         }
         // the derivative of B through z and β
-        let g7 = self.contracted_third(&ch.z, &m6);
+        let g7 = if pb == bm {
+            // P is the identity: M = sym(J a (J b)ᵀ), and ⟨M, ∇²Ψ⟩ = (J a)ᵀ ∇²Ψ (J b) in one evaluation
+            self.contracted_pair(&ch.z, &ja, &jb)
+        } else {
+            self.contracted_third(&ch.z, &m6)
+        };
         let mut wz = g7[..6].iter().map(|g| c * g).collect::<Vec<_>>();
         let mut bending_scale = c * g7[6];
         let mut r = [0.0; 6];
@@ -135,6 +140,28 @@ impl ElementModel {
             r,
             y: self.scaled(&ch.z),
         })
+    }
+
+    /// ∇_{(z, β)} αᵀ∇²_zΨ(z; β) β (7 numbers, β last) by one hyper-dual evaluation of the generic twins with
+    /// (z, β) carried as a 7-vector dual.
+    fn contracted_pair(&self, z: &[f64; 6], alpha: &[f64; 6], beta: &[f64; 6]) -> [f64; 7] {
+        let o = D7::from_re(0.0);
+        let zz: [HyperDual<D7>; 6] = std::array::from_fn(|i| {
+            HyperDual::new(
+                D7::from_re(z[i]).derivative(i),
+                D7::from_re(alpha[i]),
+                D7::from_re(beta[i]),
+                o,
+            )
+        });
+        let b = HyperDual::new(D7::from_re(self.bending_scale).derivative(6), o, o, o);
+        let y: [HyperDual<D7>; 6] = std::array::from_fn(|i| if i < 3 { zz[i] } else { b * zz[i] });
+        let mut psi = self.material.reference(&y);
+        if let Some(cb) = &self.collapse {
+            psi += cb.reference(&zz);
+        }
+        let g = psi.eps1eps2.eps.unwrap_generic(Const::<7>, U1);
+        std::array::from_fn(|i| g[i])
     }
 
     /// ∇_{(z, β)} ⟨M, ∇²_zΨ(z; β)⟩ (7 numbers, β last) by forward-mode AD of ψ's and the collapse barrier's

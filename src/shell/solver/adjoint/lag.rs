@@ -367,32 +367,54 @@ impl Simulation {
             })?;
         let kappa = lag.kappa;
         let mat = &self.model.material;
-        let mut basis = BasisEvaluator::new(mat);
-        for ((st, hm), l) in self.stencils.iter().zip(&lag.hd).zip(&lags) {
-            let a = gather(st, mu);
-            let local: [f64; NDOF] = std::array::from_fn(|r| {
-                kappa * ((0..NDOF).map(|j| hm[r][j] * a[j]).sum::<f64>() - l.grad[r])
-            });
+        let material = out.material.is_some();
+        // per triangle: its share of x̄_k and, with the material, of dJ/dc_j (in parallel, summed in order)
+        let parts: Vec<TriangleShare> = self
+            .stencils
+            .par_iter()
+            .zip(lag.hd.par_iter())
+            .zip(lags.par_iter())
+            .map_init(
+                || BasisEvaluator::new(mat),
+                |basis, ((st, hm), l)| {
+                    let a = gather(st, mu);
+                    let local: [f64; NDOF] = std::array::from_fn(|r| {
+                        kappa * ((0..NDOF).map(|j| hm[r][j] * a[j]).sum::<f64>() - l.grad[r])
+                    });
+                    let mut coefs = vec![];
+                    if material {
+                        for c in mat.support(&l.y) {
+                            if c == Coefficient::Constant {
+                                continue;
+                            }
+                            let p = basis.basis_hessian(c, &l.y);
+                            let mut d: f64 = (0..6).map(|i| l.r[i] * p.grad[i]).sum();
+                            for i in 0..6 {
+                                d += (0..6).map(|j| l.n[i][j] * p.hess[i][j]).sum::<f64>();
+                            }
+                            coefs.push((c, kappa * d));
+                        }
+                    }
+                    (local, coefs)
+                },
+            )
+            .collect();
+        for ((st, l), (local, coefs)) in self.stencils.iter().zip(&lags).zip(parts) {
             scatter(st, &local, xbar);
             out.stiffness -= kappa * l.value / self.model.stiffness;
             out.bending_scale -= kappa * l.bending_scale;
             if let Some(gc) = out.material.as_mut() {
-                for c in mat.support(&l.y) {
-                    if c == Coefficient::Constant {
-                        continue;
-                    }
-                    let p = basis.basis_hessian(c, &l.y);
-                    let mut d: f64 = (0..6).map(|i| l.r[i] * p.grad[i]).sum();
-                    for i in 0..6 {
-                        d += (0..6).map(|j| l.n[i][j] * p.hess[i][j]).sum::<f64>();
-                    }
-                    *gc.get_mut(c) -= kappa * d;
+                for (c, d) in coefs {
+                    *gc.get_mut(c) -= d;
                 }
             }
         }
         Ok(())
     }
 }
+
+/// One triangle's share of x̄_k and its (coefficient, (c/h) ∂φ/∂c_j) pairs.
+type TriangleShare = ([f64; NDOF], Vec<(Coefficient, f64)>);
 
 /// out[dofs of the stencil's present vertices] += local.
 fn scatter(st: &crate::shell::mesh::Stencil, local: &[f64; NDOF], out: &mut [f64]) {
