@@ -1,5 +1,6 @@
 //! Calibration of the yarn parameters against patterns that should be static equilibria
-//! (`docs/derivative-harness.md` item b, `docs/yarn-model.md` "What the original reference patterns tell").
+//! (`docs/results.md`, "Validation against the original", item b; `docs/yarn-model.md` "What the original
+//! reference patterns tell").
 //!
 //! At a pattern's stored state the energy gradient is linear in the stiffness parameters:
 //!

@@ -1,4 +1,4 @@
-//! Validation against the original method's data (`docs/derivative-harness.md`, section 3): the
+//! Validation against the original method's data (`docs/results.md`, "Validation against the original"): the
 //! measurements behind `hylc validate` and the conformance tests. Each function reads `../shared` (the caller
 //! passes the folder) and returns numbers; the callers decide what passes.
 

@@ -1,5 +1,5 @@
-//! Verification and validation against the original method's data (`docs/derivative-harness.md`,
-//! section 3), kept out of the numerical core: the stages below know nothing of it.
+//! Verification and validation against the original method's data (`docs/results.md`,
+//! "Validation against the original"), kept out of the numerical core: the stages below know nothing of it.
 //!
 //! - [`conformance`]: ψ and the strain chain against the original code's oracle vectors (item 3a);
 //! - [`calibration`]: the yarn parameters that make the original reference patterns static equilibria (item 3b);

@@ -12,7 +12,7 @@ use std::process::ExitCode;
 #[derive(clap::Args, Clone, Debug)]
 pub struct SolverArgs {
     /// force tolerance relative to the stretching stiffness
-    #[arg(long, default_value_t = 1e-8)]
+    #[arg(long, default_value = "1e-8")]
     pub tolerance: f64,
     /// Newton step limit
     #[arg(long, default_value_t = 2000)]

@@ -39,7 +39,7 @@ pub struct Args {
     duration: Option<f64>,
     /// time step of the cloth simulation (s); 1/60 by default, with adaptive substeps inside a step when Newton
     /// does not converge (down to 1/64 of it)
-    #[arg(long, default_value_t = 1.0 / 60.0)]
+    #[arg(long, default_value_t = 1.0 / 60.0, hide_default_value = true)]
     dt: f64,
     /// delete the output folder first instead of resuming
     #[arg(long)]

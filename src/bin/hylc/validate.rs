@@ -1,4 +1,4 @@
-//! `hylc validate`: the validation items of `docs/derivative-harness.md`, section 3, that the stages
+//! `hylc validate`: the validation items of `docs/results.md`, "Validation against the original", that the stages
 //! built, run against `../shared` and written as one Markdown results table (and, with `--readme`, into the
 //! README between the markers `<!-- validate:begin -->` and `<!-- validate:end -->`). Skips cleanly, with a
 //! message and exit code 0, when `../shared` is absent.
@@ -29,9 +29,10 @@ struct Row {
     command: String,
 }
 
-/// The validation items of docs/derivative-harness.md (section 3) against ../shared: conformance with the original
-/// code, the original patterns as equilibria, the micro solver against the original displacements, the fitted
-/// materials against the original ones; writes the results table (skips when ../shared is absent).
+/// The validation items of docs/results.md ("Validation against the original") against ../shared: conformance
+/// with the original code, the original patterns as equilibria, the micro solver against the original
+/// displacements, the fitted materials against the original ones; writes the results table (skips when ../shared
+/// is absent).
 #[derive(clap::Args)]
 pub struct Args {
     /// the results table (Markdown)
@@ -316,9 +317,9 @@ fn item_d(rows: &mut Vec<Row>) {
 fn format_table(rows: &[Row], grid_limit: Option<usize>, time: f64) -> String {
     let mut s = String::new();
     s.push_str(&format!(
-        "Written by `hylc validate{}` in {time:.0} s (`docs/derivative-harness.md`, section 3; a: conformance with the \
-         original code, b: the original patterns as equilibria of our yarn model, c: our micro solver against the \
-         original's displacements, d: our fitted materials against the original's).\n\n",
+        "Written by `hylc validate{}` in {time:.0} s (`docs/results.md`, \"Validation against the original\"; \
+         a: conformance with the original code, b: the original patterns as equilibria of our yarn model, c: our \
+         micro solver against the original's displacements, d: our fitted materials against the original's).\n\n",
         grid_limit.map_or(" --full".to_string(), |n| format!(" --grid-limit {n}"))
     ));
     s.push_str("| item | what | measured | target | verdict | reproduce |\n| --- | --- | --- | --- | --- | --- |\n");

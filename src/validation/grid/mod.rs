@@ -1,4 +1,4 @@
-//! Validation item 3c (`docs/derivative-harness.md`, section 3c): our micro solver against the original
+//! Validation item c (`docs/results.md`, "Validation against the original"): our micro solver against the original
 //! solver's equilibrium displacements on the 9×9×9 in-plane strain grid of `../shared/data/hylc2020/displacements/`.
 //!
 //! Data ([`GridData`]): `axes.txt` lists the nine s_x, s_a and s_y values (one line each); `data.npy` is float32 of
@@ -285,7 +285,7 @@ impl GridData {
 }
 
 /// Our counterpart of the original displacement rows for a state at an in-plane strain: per vertex
-/// (F₂⁻¹ ũ_xy, ũ_z, θ − θ_ref) (`docs/derivative-harness.md`, 3c), with ũ the world displacement from φ(ξ_v) + h_v n.
+/// (F₂⁻¹ ũ_xy, ũ_z, θ − θ_ref) (`docs/results.md`, item c), with ũ the world displacement from φ(ξ_v) + h_v n.
 /// `None` for a bending strain (the original grid is in-plane only).
 pub fn counterpart(pattern: &Pattern, state: &MicroState) -> Option<Vec<[f64; 4]>> {
     let z = state.strain.0;
