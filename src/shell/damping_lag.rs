@@ -109,7 +109,12 @@ impl ElementModel {
         let mut wz = g7[..6].iter().map(|g| c * g).collect::<Vec<_>>();
         let mut bending_scale = c * g7[6];
         let mut r = [0.0; 6];
-        let stretch = in_plane_second(q, rest, a, b);
+        // the stretch terms act only where their weight is positive (not on a triangle compressed both ways)
+        let stretch = if w[0] > 0.0 || w[2] > 0.0 {
+            in_plane_second(q, rest, a, b)
+        } else {
+            [(0.0, [0.0; NDOF]); 2]
+        };
         for (k, (t, tg)) in [(0, stretch[0]), (2, stretch[1])] {
             if w[k] <= 0.0 {
                 continue;
